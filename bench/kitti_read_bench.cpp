@@ -1,0 +1,47 @@
+// Reading one KITTI frame (PNG + 1.9 MB Velodyne + calib + labels) vs the PNG decode alone, the
+// peer that bounds what the frame reader can cost.
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+
+#include "fusedet/fusion/kitti.h"
+
+namespace {
+const std::filesystem::path kRoot = std::filesystem::path(FUSEDET_DATA_DIR) / "kitti";
+
+void BM_ReadKittiFrame(benchmark::State& state) {
+  for (auto _ : state) benchmark::DoNotOptimize(fusedet::fusion::readKittiFrame(kRoot, "000000"));
+}
+BENCHMARK(BM_ReadKittiFrame)->Unit(benchmark::kMillisecond);
+
+void BM_OpenCvImreadOnly(benchmark::State& state) {
+  const auto png = (kRoot / "image_2" / "000000.png").string();
+  for (auto _ : state) benchmark::DoNotOptimize(cv::imread(png, cv::IMREAD_COLOR));
+}
+BENCHMARK(BM_OpenCvImreadOnly)->Unit(benchmark::kMillisecond);
+
+// Collects each benchmark's mean time so main() can print the headline lines.
+class HeadlineReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& r : runs)
+      if (r.run_type == Run::RT_Iteration) ms[r.benchmark_name()] = r.GetAdjustedRealTime();
+  }
+  std::map<std::string, double> ms;
+};
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  HeadlineReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const double ours = reporter.ms["BM_ReadKittiFrame"], png = reporter.ms["BM_OpenCvImreadOnly"];
+  std::printf("bench: kitti_read_ms %.3f\n", ours);
+  std::printf("bench: kitti_read_vs_png_decode %.3f\n", png > 0 ? ours / png : 0.0);
+  return 0;
+}

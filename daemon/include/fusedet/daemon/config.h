@@ -1,0 +1,88 @@
+#pragma once
+// Config: the daemon's one YAML file (config/fusedet.yaml documents every key and default).
+// Loading is strict: unknown keys, wrong types and out-of-range values are errors that name the
+// file, the key path and the line.
+
+#include <array>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace fusedet::daemon {
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Config {
+  int version = 1;
+  std::string logLevel = "info";
+
+  struct Socket {
+    std::string path = "/run/fusedet/fusedet.sock";
+    int maxClients = 16;
+  } socket;
+
+  struct Laser {
+    std::string device = "/dev/ttyUSB0";
+    int baud = 38400;
+    int angleDeg = 180;
+    double resolutionDeg = 0.5;
+    bool remission = false;
+    double reconnectMaxS = 5.0;
+  } laser;
+
+  struct Tilt {
+    std::string interface = "can0";
+    int nodeId = 5;
+    double minDeg = -30, maxDeg = 30, speedDegS = 15;
+    int countsPerRev = 4096;
+    double gearRatio = 50;
+    long zeroOffsetCounts = 0;
+    int heartbeatMs = 100;
+  } tilt;
+
+  struct Camera {
+    std::string device = "/dev/video0";
+    std::string format = "yuyv";
+    int width = 640, height = 480, fps = 15;
+    std::string calibration = "/etc/fusedet/camera.yaml";
+  } camera;
+
+  struct Fusion {
+    std::array<double, 3> rotationRpyDeg{-90, 0, -90};
+    std::array<double, 3> translation{0, -0.10, 0};
+    std::array<double, 3> tiltAxisOffset{0, 0, 0.05};
+    double laserLayerScale = 0.5;
+    int holeFillRadius = 2;
+    int maxPairSkewMs = 150;
+    int tiltWindowMs = 50;
+  } fusion;
+
+  struct Detection {
+    std::vector<std::string> models{"/usr/share/fusedet/models/car.yaml"};
+    double scaleFactor = 1.1;
+    std::array<int, 2> minSize{24, 24};
+    std::array<int, 2> maxSize{0, 0};
+    double step = 0.05;
+    std::string grouping = "nms";
+    double nmsIou = 0.4;
+    int minNeighbors = 3;
+    int threads = 0;
+  } detection;
+
+  struct Replay {
+    std::string file;
+    bool realtime = true;
+  } replay;
+};
+
+// Throws ConfigError ("FILE:LINE: key.path: reason").
+Config loadConfig(const std::filesystem::path& file);
+Config parseConfig(const std::string& yamlText, const std::string& sourceName);
+// The effective configuration as YAML, every key present (for --check-config and status).
+std::string dumpConfig(const Config& config);
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,260 @@
+#include "fusedet/daemon/config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace fusedet::daemon {
+namespace {
+
+// Walks one YAML mapping, reads known keys into fields and rejects unknown ones, so a typo in a
+// key never silently falls back to a default.
+class Section {
+ public:
+  Section(const YAML::Node& node, std::string path, const std::string& source)
+      : node_(node), path_(std::move(path)), source_(source) {
+    if (node_ && !node_.IsNull() && !node_.IsMap()) fail(node_, "expected a mapping");
+  }
+
+  template <class T>
+  void read(const char* key, T& out) {
+    seen_.insert(key);
+    if (!node_ || node_.IsNull()) return;
+    const YAML::Node v = node_[key];
+    if (!v) return;
+    try {
+      out = v.as<T>();
+    } catch (const YAML::Exception&) {
+      fail(v, std::string("key ") + keyPath(key) + ": wrong type");
+    }
+  }
+
+  template <class T>
+  void readRange(const char* key, T& out, T lo, T hi) {
+    read(key, out);
+    if (out < lo || out > hi) {
+      std::ostringstream msg;
+      msg << "key " << keyPath(key) << ": " << out << " is outside [" << lo << ", " << hi << "]";
+      fail(node_ ? node_[key] : node_, msg.str());
+    }
+  }
+
+  template <class T>
+  void readOneOf(const char* key, T& out, std::initializer_list<T> allowed) {
+    read(key, out);
+    for (const T& a : allowed)
+      if (a == out) return;
+    std::ostringstream msg;
+    msg << "key " << keyPath(key) << ": '" << out << "' is not one of:";
+    for (const T& a : allowed) msg << ' ' << a;
+    fail(node_ ? node_[key] : node_, msg.str());
+  }
+
+  Section child(const char* key) {
+    seen_.insert(key);
+    return Section(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), keyPath(key), source_);
+  }
+
+  // Call after all reads: any key not read is unknown.
+  void finish() const {
+    if (!node_ || !node_.IsMap()) return;
+    for (const auto& kv : node_) {
+      const auto key = kv.first.as<std::string>();
+      if (!seen_.count(key)) fail(kv.first, "unknown key " + keyPath(key.c_str()));
+    }
+  }
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& what) const {
+    std::ostringstream msg;
+    msg << source_;
+    if (at && at.Mark().line >= 0) msg << ':' << at.Mark().line + 1;
+    msg << ": " << what;
+    throw ConfigError(msg.str());
+  }
+
+ private:
+  std::string keyPath(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  YAML::Node node_;
+  std::string path_;
+  const std::string& source_;
+  std::set<std::string> seen_;
+};
+
+}  // namespace
+
+Config parseConfig(const std::string& yamlText, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yamlText);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
+  }
+  Config c;
+  Section top(root, "", source);
+  top.readRange("version", c.version, 1, 1);
+  {
+    Section s = top.child("log");
+    s.readOneOf<std::string>("level", c.logLevel, {"trace", "debug", "info", "warn", "error"});
+    s.finish();
+  }
+  {
+    Section s = top.child("socket");
+    s.read("path", c.socket.path);
+    s.readRange("max_clients", c.socket.maxClients, 1, 1024);
+    s.finish();
+  }
+  {
+    Section s = top.child("laser");
+    s.read("device", c.laser.device);
+    s.readOneOf("baud", c.laser.baud, {9600, 19200, 38400, 500000});
+    s.readOneOf("angle_deg", c.laser.angleDeg, {180, 100});
+    s.readOneOf("resolution_deg", c.laser.resolutionDeg, {1.0, 0.5, 0.25});
+    if (c.laser.angleDeg == 180 && c.laser.resolutionDeg == 0.25)
+      s.fail(YAML::Node(), "laser: resolution_deg 0.25 needs angle_deg 100 (the LMS rejects 180/0.25)");
+    s.read("remission", c.laser.remission);
+    s.readRange("reconnect_max_s", c.laser.reconnectMaxS, 0.1, 600.0);
+    s.finish();
+  }
+  {
+    Section s = top.child("tilt");
+    s.read("interface", c.tilt.interface);
+    s.readRange("node_id", c.tilt.nodeId, 1, 127);
+    s.readRange("min_deg", c.tilt.minDeg, -90.0, 90.0);
+    s.readRange("max_deg", c.tilt.maxDeg, -90.0, 90.0);
+    if (c.tilt.minDeg >= c.tilt.maxDeg) s.fail(YAML::Node(), "tilt: min_deg must be below max_deg");
+    s.readRange("speed_deg_s", c.tilt.speedDegS, 0.1, 360.0);
+    s.readRange("counts_per_rev", c.tilt.countsPerRev, 1, 1 << 24);
+    s.readRange("gear_ratio", c.tilt.gearRatio, 1e-3, 1e6);
+    s.read("zero_offset_counts", c.tilt.zeroOffsetCounts);
+    s.readRange("heartbeat_ms", c.tilt.heartbeatMs, 1, 65535);
+    s.finish();
+  }
+  {
+    Section s = top.child("camera");
+    s.read("device", c.camera.device);
+    s.readOneOf<std::string>("format", c.camera.format, {"yuyv", "mjpeg"});
+    s.readRange("width", c.camera.width, 16, 8192);
+    s.readRange("height", c.camera.height, 16, 8192);
+    s.readRange("fps", c.camera.fps, 1, 240);
+    s.read("calibration", c.camera.calibration);
+    s.finish();
+  }
+  {
+    Section s = top.child("fusion");
+    Section e = s.child("laser_to_camera");
+    e.read("rotation_rpy_deg", c.fusion.rotationRpyDeg);
+    e.read("translation", c.fusion.translation);
+    e.finish();
+    s.read("tilt_axis_offset", c.fusion.tiltAxisOffset);
+    s.readRange("laser_layer_scale", c.fusion.laserLayerScale, 0.05, 1.0);
+    s.readRange("hole_fill_radius", c.fusion.holeFillRadius, 0, 32);
+    s.readRange("max_pair_skew_ms", c.fusion.maxPairSkewMs, 0, 10000);
+    s.readRange("tilt_window_ms", c.fusion.tiltWindowMs, 1, 10000);
+    s.finish();
+  }
+  {
+    Section s = top.child("detection");
+    s.read("models", c.detection.models);
+    s.readRange("scale_factor", c.detection.scaleFactor, 1.01, 4.0);
+    s.read("min_size", c.detection.minSize);
+    s.read("max_size", c.detection.maxSize);
+    s.readRange("step", c.detection.step, 0.001, 1.0);
+    s.readOneOf<std::string>("grouping", c.detection.grouping, {"nms", "opencv"});
+    s.readRange("nms_iou", c.detection.nmsIou, 0.0, 1.0);
+    s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
+    s.readRange("threads", c.detection.threads, 0, 256);
+    s.finish();
+  }
+  {
+    Section s = top.child("replay");
+    s.read("file", c.replay.file);
+    s.read("realtime", c.replay.realtime);
+    s.finish();
+  }
+  top.finish();
+  return c;
+}
+
+Config loadConfig(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw ConfigError(file.string() + ": cannot open config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return parseConfig(text.str(), file.string());
+}
+
+std::string dumpConfig(const Config& c) {
+  YAML::Emitter out;
+  auto seq = [&out](const auto& values) {
+    out << YAML::Flow << YAML::BeginSeq;
+    for (const auto& v : values) out << v;
+    out << YAML::EndSeq;
+  };
+  out << YAML::BeginMap;
+  out << YAML::Key << "version" << YAML::Value << c.version;
+  out << YAML::Key << "log" << YAML::Value << YAML::BeginMap << YAML::Key << "level" << YAML::Value
+      << c.logLevel << YAML::EndMap;
+  out << YAML::Key << "socket" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "path" << YAML::Value << c.socket.path;
+  out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients << YAML::EndMap;
+  out << YAML::Key << "laser" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "device" << YAML::Value << c.laser.device;
+  out << YAML::Key << "baud" << YAML::Value << c.laser.baud;
+  out << YAML::Key << "angle_deg" << YAML::Value << c.laser.angleDeg;
+  out << YAML::Key << "resolution_deg" << YAML::Value << c.laser.resolutionDeg;
+  out << YAML::Key << "remission" << YAML::Value << c.laser.remission;
+  out << YAML::Key << "reconnect_max_s" << YAML::Value << c.laser.reconnectMaxS << YAML::EndMap;
+  out << YAML::Key << "tilt" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "interface" << YAML::Value << c.tilt.interface;
+  out << YAML::Key << "node_id" << YAML::Value << c.tilt.nodeId;
+  out << YAML::Key << "min_deg" << YAML::Value << c.tilt.minDeg;
+  out << YAML::Key << "max_deg" << YAML::Value << c.tilt.maxDeg;
+  out << YAML::Key << "speed_deg_s" << YAML::Value << c.tilt.speedDegS;
+  out << YAML::Key << "counts_per_rev" << YAML::Value << c.tilt.countsPerRev;
+  out << YAML::Key << "gear_ratio" << YAML::Value << c.tilt.gearRatio;
+  out << YAML::Key << "zero_offset_counts" << YAML::Value << c.tilt.zeroOffsetCounts;
+  out << YAML::Key << "heartbeat_ms" << YAML::Value << c.tilt.heartbeatMs << YAML::EndMap;
+  out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "device" << YAML::Value << c.camera.device;
+  out << YAML::Key << "format" << YAML::Value << c.camera.format;
+  out << YAML::Key << "width" << YAML::Value << c.camera.width;
+  out << YAML::Key << "height" << YAML::Value << c.camera.height;
+  out << YAML::Key << "fps" << YAML::Value << c.camera.fps;
+  out << YAML::Key << "calibration" << YAML::Value << c.camera.calibration << YAML::EndMap;
+  out << YAML::Key << "fusion" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "laser_to_camera" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "rotation_rpy_deg" << YAML::Value;
+  seq(c.fusion.rotationRpyDeg);
+  out << YAML::Key << "translation" << YAML::Value;
+  seq(c.fusion.translation);
+  out << YAML::EndMap;
+  out << YAML::Key << "tilt_axis_offset" << YAML::Value;
+  seq(c.fusion.tiltAxisOffset);
+  out << YAML::Key << "laser_layer_scale" << YAML::Value << c.fusion.laserLayerScale;
+  out << YAML::Key << "hole_fill_radius" << YAML::Value << c.fusion.holeFillRadius;
+  out << YAML::Key << "max_pair_skew_ms" << YAML::Value << c.fusion.maxPairSkewMs;
+  out << YAML::Key << "tilt_window_ms" << YAML::Value << c.fusion.tiltWindowMs << YAML::EndMap;
+  out << YAML::Key << "detection" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "models" << YAML::Value;
+  seq(c.detection.models);
+  out << YAML::Key << "scale_factor" << YAML::Value << c.detection.scaleFactor;
+  out << YAML::Key << "min_size" << YAML::Value;
+  seq(c.detection.minSize);
+  out << YAML::Key << "max_size" << YAML::Value;
+  seq(c.detection.maxSize);
+  out << YAML::Key << "step" << YAML::Value << c.detection.step;
+  out << YAML::Key << "grouping" << YAML::Value << c.detection.grouping;
+  out << YAML::Key << "nms_iou" << YAML::Value << c.detection.nmsIou;
+  out << YAML::Key << "min_neighbors" << YAML::Value << c.detection.minNeighbors;
+  out << YAML::Key << "threads" << YAML::Value << c.detection.threads << YAML::EndMap;
+  out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "file" << YAML::Value << c.replay.file;
+  out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime << YAML::EndMap;
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,51 @@
+#include "fusedet/daemon/config.h"
+
+#include <gtest/gtest.h>
+
+using namespace fusedet::daemon;
+
+namespace {
+std::string errorOf(const std::string& yaml) {
+  try {
+    (void)parseConfig(yaml, "test.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(Config, ShippedFileParsesAndEqualsTheDefaults) {
+  const Config shipped = loadConfig(std::string(FUSEDET_SOURCE_DIR) + "/config/fusedet.yaml");
+  // The documented file and the built-in defaults must not drift apart.
+  EXPECT_EQ(dumpConfig(shipped), dumpConfig(Config{}));
+  EXPECT_EQ(shipped.laser.baud, 38400);
+  EXPECT_EQ(shipped.detection.grouping, "nms");
+}
+
+TEST(Config, EmptyFileGivesDefaultsAndDumpRoundTrips) {
+  const Config c = parseConfig("", "empty.yaml");
+  EXPECT_EQ(c.socket.path, "/run/fusedet/fusedet.sock");
+  Config changed = c;
+  changed.laser.baud = 500000;
+  changed.detection.models = {"a.yaml", "b.yaml"};
+  const Config back = parseConfig(dumpConfig(changed), "dump.yaml");
+  EXPECT_EQ(back.laser.baud, 500000);
+  EXPECT_EQ(back.detection.models, changed.detection.models);
+}
+
+TEST(Config, ErrorsNameFileLineAndKey) {
+  EXPECT_EQ(errorOf("laser:\n  baud: 12345\n"),
+            "test.yaml:2: key laser.baud: '12345' is not one of: 9600 19200 38400 500000");
+  EXPECT_EQ(errorOf("laser:\n  bauds: 9600\n"), "test.yaml:2: unknown key laser.bauds");
+  EXPECT_EQ(errorOf("tilt:\n  node_id: abc\n"), "test.yaml:2: key tilt.node_id: wrong type");
+  EXPECT_EQ(errorOf("tilt:\n  node_id: 200\n"), "test.yaml:2: key tilt.node_id: 200 is outside [1, 127]");
+  EXPECT_NE(errorOf("laser: [1, 2\n").find("YAML syntax"), std::string::npos);
+  EXPECT_NE(errorOf("laser: 5\n").find("expected a mapping"), std::string::npos);
+  EXPECT_NE(errorOf("laser:\n  resolution_deg: 0.25\n").find("needs angle_deg 100"), std::string::npos);
+  EXPECT_NE(errorOf("tilt:\n  min_deg: 10\n  max_deg: 5\n").find("min_deg must be below"), std::string::npos);
+}
+
+TEST(Config, MissingFile) {
+  EXPECT_THROW((void)loadConfig("/nonexistent/fusedet.yaml"), ConfigError);
+}

@@ -1,0 +1,70 @@
+#include "fusedet/fusion/kitti.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+using namespace fusedet::fusion;
+
+namespace {
+const fs::path kKitti = fs::path(FUSEDET_DATA_DIR) / "kitti";
+
+fs::path writeTemp(const std::string& name, const std::string& text) {
+  const fs::path p = fs::temp_directory_path() / ("fusedet_kitti_test_" + name);
+  std::ofstream(p) << text;
+  return p;
+}
+}  // namespace
+
+TEST(Kitti, ReadsARealFrame) {
+  const auto ids = listKittiFrames(kKitti);
+  ASSERT_EQ(ids.size(), 52u);  // SOURCE.md: every 3rd frame of 154
+  EXPECT_EQ(ids.front(), "000000");
+  const KittiFrame f = readKittiFrame(kKitti, "000000");
+  EXPECT_EQ(f.image.cols, 1242);
+  EXPECT_EQ(f.image.rows, 375);
+  EXPECT_EQ(f.points.size() * 16, fs::file_size(kKitti / "velodyne" / "000000.bin"));
+  EXPECT_GT(f.points.size(), 98'000u);
+  // P2 of drive 0005 (calib/000000.txt): fx = 721.5377, cx = 609.5593
+  EXPECT_DOUBLE_EQ(f.calib.P2(0, 0), 721.5377);
+  EXPECT_DOUBLE_EQ(f.calib.P2(0, 2), 609.5593);
+  // label_2/000000.txt: 2 DontCare then a Van at x 296.744956..455.226042
+  ASSERT_GE(f.labels.size(), 3u);
+  EXPECT_TRUE(f.labels[0].ignore);
+  EXPECT_EQ(f.labels[2].sourceClass, "Van");
+  EXPECT_NEAR(f.labels[2].box.w, 455.226042 - 296.744956, 1e-9);
+}
+
+TEST(Kitti, MapsClasses) {
+  const auto p = writeTemp("labels.txt",
+                           "Car 0 1 0 10 20 30 60 0 0 0 0 0 0 0\n"
+                           "Pedestrian 0 0 0 1 2 3 4 0 0 0 0 0 0 0\n"
+                           "Cyclist 0 0 0 1 2 3 4 0 0 0 0 0 0 0\n"
+                           "Tram 0 0 0 1 2 3 4 0 0 0 0 0 0 0\n");
+  const auto labels = readKittiLabels(p);
+  ASSERT_EQ(labels.size(), 4u);
+  EXPECT_EQ(labels[0].className, "car");
+  EXPECT_EQ(labels[0].occlusion, 1);
+  EXPECT_EQ(labels[0].box, (fusedet::Box{10, 20, 20, 40}));
+  EXPECT_EQ(labels[1].className, "person");
+  EXPECT_EQ(labels[2].className, "bike");
+  EXPECT_TRUE(labels[3].ignore);
+}
+
+TEST(Kitti, BadFilesNameTheFileAndProblem) {
+  const auto calib = writeTemp("calib.txt", "P2: 1 2 3\n");
+  try {
+    (void)readKittiCalib(calib);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(calib.string()), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("P2"), std::string::npos);
+  }
+  const auto velo = writeTemp("velo.bin", std::string(17, '\0'));
+  EXPECT_THROW((void)readKittiVelodyne(velo), std::runtime_error);
+  const auto labels = writeTemp("bad_labels.txt", "Car 0 0 x\n");
+  EXPECT_THROW((void)readKittiLabels(labels), std::runtime_error);
+  EXPECT_THROW((void)readKittiFrame(kKitti, "999999"), std::runtime_error);
+}

@@ -1,0 +1,65 @@
+// fusedet: the command line of the fusedet perception system (see `fusedet --help`).
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+#include <iostream>
+#include <algorithm>
+#include <map>
+
+#include "command.h"
+
+namespace fusedet::tools {
+
+namespace {
+std::vector<Command>& registry() {
+  static std::vector<Command> commands;
+  return commands;
+}
+}  // namespace
+
+bool registerCommand(std::string name, std::string description, CommandSetup setup) {
+  registry().push_back(Command{std::move(name), std::move(description), std::move(setup)});
+  return true;
+}
+
+const std::vector<Command>& commands() { return registry(); }
+
+}  // namespace fusedet::tools
+
+int main(int argc, char** argv) {
+  using namespace fusedet::tools;
+  CLI::App app{
+      "fusedet - object detection on fused camera + tilting-laser data with boosted cascades\n"
+      "trained on a joint feature pool (Klein, Schulz, Frintrop). Each subcommand has its own\n"
+      "--help. Data paths default to ../shared/data (the KITTI frames beside the checkout).",
+      "fusedet"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("fusedet ") + FUSEDET_VERSION);
+  std::string logLevel = "warn";
+  app.add_option("--log-level", logLevel, "trace|debug|info|warn|error")->capture_default_str();
+
+  std::vector<Command> sorted = commands();
+  std::sort(sorted.begin(), sorted.end(), [](const Command& a, const Command& b) { return a.name < b.name; });
+  std::map<CLI::App*, CommandRunner> runners;
+  for (const Command& c : sorted) {
+    CLI::App* sub = app.add_subcommand(c.name, c.description);
+    runners[sub] = c.setup(*sub);
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  spdlog::set_level(spdlog::level::from_str(logLevel));
+  for (auto& [sub, run] : runners) {
+    if (!sub->parsed()) continue;
+    try {
+      return run();
+    } catch (const std::exception& e) {
+      std::cerr << "fusedet " << sub->get_name() << ": error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+  return 2;
+}
