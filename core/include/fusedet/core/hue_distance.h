@@ -1,0 +1,15 @@
+#pragma once
+// Hue distance (paper §3.1): the angular distance between each pixel's hue and a class's
+// reference hue, so that hue, an angle, becomes a totally ordered value a Haar feature can use.
+
+#include <opencv2/core/mat.hpp>
+
+namespace fusedet {
+
+// Angular distance in degrees, in [0, 180], of two hues in degrees (any real values; wraps at 360).
+double hueDistanceDeg(double hueDeg, double referenceDeg);
+
+// hueDeg: CV_32FC1 hue in degrees [0, 360). Returns CV_32FC1 of the same size, values in [0, 180].
+cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, double referenceDeg);
+
+}  // namespace fusedet
