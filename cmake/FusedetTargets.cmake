@@ -19,6 +19,7 @@ function(fusedet_library name)
   set_target_properties(${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   fusedet_warnings(${name})
   install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(TARGETS ${name} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endfunction()
 
 # fusedet_test(<name> SOURCES ... DEPS ... [LABELS ...]): a GoogleTest binary, each TEST a ctest case.
