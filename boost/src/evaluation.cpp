@@ -1,0 +1,110 @@
+#include "fusedet/boost/evaluation.h"
+
+#include <algorithm>
+#include <numeric>
+
+#include "fusedet/core/box.h"
+
+namespace fusedet::boosting {
+namespace {
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+}  // namespace
+
+LabelRole labelRole(const Label& label, const MatchConfig& config) {
+  if (label.ignore || contains(config.ignoreClasses, label.className)) return LabelRole::kIgnoreRegion;
+  if (label.className != config.className && !contains(config.aliasClasses, label.className))
+    return LabelRole::kBackground;
+  const bool tooSmall = label.box.h < config.minHeight;
+  const bool tooOccluded = label.occlusion > config.maxOcclusion;
+  const bool tooTruncated = config.maxTruncation >= 0 && label.truncation > config.maxTruncation;
+  return (tooSmall || tooOccluded || tooTruncated) ? LabelRole::kIgnoredLabel : LabelRole::kPositive;
+}
+
+StackMatch matchDetections(const std::vector<Detection>& detections, const Labels& labels,
+                           const MatchConfig& config) {
+  StackMatch m;
+  m.detections.assign(detections.size(), DetectionOutcome::kIgnored);
+  m.labelRoles.reserve(labels.size());
+  for (const Label& l : labels) {
+    m.labelRoles.push_back(labelRole(l, config));
+    if (m.labelRoles.back() == LabelRole::kPositive) ++m.positives;
+  }
+  m.hitBy.assign(labels.size(), -1);
+
+  // Highest score first; ties by index, so the result does not depend on the sort's stability.
+  std::vector<std::size_t> order(detections.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    if (detections[a].score != detections[b].score) return detections[a].score > detections[b].score;
+    return a < b;
+  });
+
+  for (std::size_t d : order) {
+    const Detection& det = detections[d];
+    if (!det.className.empty() && det.className != config.className) continue;  // stays kIgnored
+    // 1. the best free positive
+    int best = -1;
+    double bestIou = 0;
+    for (std::size_t l = 0; l < labels.size(); ++l) {
+      if (m.labelRoles[l] != LabelRole::kPositive || m.hitBy[l] >= 0) continue;
+      const double o = iou(det.box, labels[l].box);
+      if (o >= config.minIou && o > bestIou) {
+        bestIou = o;
+        best = static_cast<int>(l);
+      }
+    }
+    if (best >= 0) {
+      m.hitBy[static_cast<std::size_t>(best)] = static_cast<int>(d);
+      m.detections[d] = DetectionOutcome::kHit;
+      ++m.hits;
+      continue;
+    }
+    // 2. an ignored label of the class, or an ignore region holding the detection
+    bool absorbed = false;
+    for (std::size_t l = 0; l < labels.size() && !absorbed; ++l) {
+      if (m.labelRoles[l] == LabelRole::kIgnoredLabel)
+        absorbed = iou(det.box, labels[l].box) >= config.minIou;
+      else if (m.labelRoles[l] == LabelRole::kIgnoreRegion)
+        absorbed = coverage(det.box, labels[l].box) >= config.minIou;
+    }
+    if (absorbed) {
+      ++m.ignored;
+      continue;
+    }
+    // 3. anything else, including a second detection on a positive already hit
+    m.detections[d] = DetectionOutcome::kFalseAlarm;
+    ++m.falseAlarms;
+  }
+  m.misses = m.positives - m.hits;
+  return m;
+}
+
+void Counts::add(const StackMatch& m) {
+  hits += m.hits;
+  falseAlarms += m.falseAlarms;
+  misses += m.misses;
+  ignored += m.ignored;
+  positives += m.positives;
+  ++stacks;
+}
+
+double Counts::recall() const {
+  return positives == 0 ? 1.0 : static_cast<double>(hits) / static_cast<double>(positives);
+}
+
+double Counts::precision() const {
+  const std::size_t detected = hits + falseAlarms;
+  return detected == 0 ? 1.0 : static_cast<double>(hits) / static_cast<double>(detected);
+}
+
+double fMeasure(double recall, double precision) {
+  return recall + precision > 0 ? 2 * recall * precision / (recall + precision) : 0.0;
+}
+
+double Counts::fMeasure() const { return boosting::fMeasure(recall(), precision()); }
+
+}  // namespace fusedet::boosting
