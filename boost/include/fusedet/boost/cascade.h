@@ -1,0 +1,79 @@
+#pragma once
+// Cascade: the in-memory model every part of boost/ shares - trained by training (model_io.h
+// reads and writes it), imported from OpenCV Haar XML (opencv_cascade.h), run by detector.h.
+//
+// A cascade is a list of stages; a stage is a list of regression stumps plus a threshold.
+// Stump: f(value) = value < threshold ? left : right. Stage: passes when the sum of its stumps is
+// >= its threshold (OpenCV rejects when sum < threshold, so both agree). A window is accepted
+// when it passes every stage; its score is the sum of the last stage.
+//
+// Two kinds of features, two clearly separated evaluation paths:
+//  - our models (Normalization::kNone): `features` are paper features a-j in unit-square window
+//    coordinates on any layer (feature.h); windows scan the layer stack directly;
+//  - imported OpenCV models (Normalization::kOpenCvVariance): `haarFeatures` are weighted
+//    rectangles in the base window's pixels (upright or 45° tilted), evaluated on OpenCV's image
+//    pyramid of one 8-bit layer with its variance normalisation, for bit-exact parity.
+// Stumps index into the vector the model's kind uses.
+
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/feature.h"
+
+namespace fusedet::boosting {
+
+enum class Normalization {
+  kNone,            // feature value as is (our models)
+  kOpenCvVariance,  // OpenCV: value / (window stddev * area), on an image pyramid of one layer
+};
+
+struct Stump {
+  int feature = 0;       // index into Cascade::features or Cascade::haarFeatures
+  double threshold = 0;  // value < threshold -> left, else right (compared in float)
+  double left = 0, right = 0;
+};
+
+struct Stage {
+  std::vector<Stump> stumps;
+  double threshold = 0;  // stage passes when sum of stump outputs >= threshold
+};
+
+// OpenCV Haar feature: up to three weighted rectangles in base-window pixels. Tilted rectangles
+// are rotated by 45°: (x, y) is the top corner, w runs down-right and h down-left.
+struct HaarRect {
+  int x = 0, y = 0, w = 0, h = 0;
+  float weight = 0;
+};
+struct HaarFeature {
+  std::array<HaarRect, 3> rects{};
+  int count = 0;
+  bool tilted = false;
+};
+
+struct Cascade {
+  std::string className;                // "car", "person", ... or the imported file's stem
+  int windowWidth = 24, windowHeight = 24;  // base window in pixels (aspect ratio = w / h)
+  std::vector<std::string> layers;          // layer names the features index
+  std::optional<double> referenceHue;       // degrees, for a "hue_distance" layer
+  Normalization normalization = Normalization::kNone;
+  std::vector<Feature> features;          // kNone
+  std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
+  std::vector<Stage> stages;
+  std::string source;  // file the model came from (for messages), may be empty
+
+  double aspectRatio() const { return double(windowWidth) / double(windowHeight); }
+  bool isOpenCv() const { return normalization == Normalization::kOpenCvVariance; }
+  std::size_t weakCount() const;
+  // Adds a feature (our kind) and returns its index for Stump::feature.
+  int addFeature(const Feature& f);
+
+  // Throws std::invalid_argument naming `source` and the first problem: no stages, empty stage,
+  // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
+  // index out of range, hue_distance without a reference hue, OpenCV model without one layer.
+  void validate() const;
+};
+
+}  // namespace fusedet::boosting

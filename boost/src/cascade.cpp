@@ -1,0 +1,76 @@
+#include "fusedet/boost/cascade.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace fusedet::boosting {
+
+std::size_t Cascade::weakCount() const {
+  std::size_t n = 0;
+  for (const Stage& s : stages) n += s.stumps.size();
+  return n;
+}
+
+int Cascade::addFeature(const Feature& f) {
+  features.push_back(f);
+  return static_cast<int>(features.size()) - 1;
+}
+
+void Cascade::validate() const {
+  const std::string where = (source.empty() ? std::string("model") : source) + ": ";
+  auto fail = [&](const std::string& what) { throw std::invalid_argument(where + what); };
+  if (windowWidth <= 0 || windowHeight <= 0) fail("window size must be positive");
+  if (stages.empty()) fail("cascade has no stages");
+  if (layers.empty()) fail("cascade names no layers");
+  if (isOpenCv()) {
+    if (layers.size() != 1) fail("an OpenCV cascade reads exactly one layer");
+    if (!features.empty()) fail("an OpenCV cascade cannot hold unit-square features");
+  } else if (!haarFeatures.empty()) {
+    fail("pixel (OpenCV) features need OpenCV variance normalisation");
+  }
+  for (const std::string& l : layers)
+    if (l == "hue_distance" && !referenceHue) fail("layer hue_distance needs a reference hue");
+  if (referenceHue && !std::isfinite(*referenceHue)) fail("reference hue is not finite");
+  const std::size_t nFeatures = isOpenCv() ? haarFeatures.size() : features.size();
+  for (std::size_t i = 0; i < features.size(); ++i) {
+    try {
+      validateFeature(features[i], layers.size());
+    } catch (const std::invalid_argument& e) {
+      fail("feature " + std::to_string(i) + ": " + e.what());
+    }
+  }
+  for (std::size_t i = 0; i < haarFeatures.size(); ++i) {
+    const HaarFeature& h = haarFeatures[i];
+    if (h.count < 2 || h.count > 3) fail("feature " + std::to_string(i) + " has " + std::to_string(h.count) + " rectangles, expected 2 or 3");
+    for (int r = 0; r < h.count; ++r) {
+      const HaarRect& q = h.rects[static_cast<std::size_t>(r)];
+      bool inside;
+      if (!h.tilted) {
+        inside = q.x >= 0 && q.y >= 0 && q.w > 0 && q.h > 0 && q.x + q.w <= windowWidth && q.y + q.h <= windowHeight;
+      } else {  // corners: top (x, y), right (x + w, y + w), left (x - h, y + h), bottom (x + w - h, y + w + h)
+        inside = q.w > 0 && q.h > 0 && q.y >= 0 && q.x - q.h >= 0 && q.x + q.w <= windowWidth &&
+                 q.y + q.w + q.h <= windowHeight;
+      }
+      if (!inside) fail("feature " + std::to_string(i) + " rectangle " + std::to_string(r) + " lies outside the " +
+                        std::to_string(windowWidth) + "x" + std::to_string(windowHeight) + " window");
+      if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
+    }
+  }
+  for (std::size_t s = 0; s < stages.size(); ++s) {
+    const Stage& st = stages[s];
+    const std::string at = "stage " + std::to_string(s);
+    if (st.stumps.empty()) fail(at + " has no weak classifiers");
+    if (!std::isfinite(st.threshold)) fail(at + " threshold is not finite");
+    for (std::size_t k = 0; k < st.stumps.size(); ++k) {
+      const Stump& t = st.stumps[k];
+      const std::string atk = at + " weak classifier " + std::to_string(k);
+      if (t.feature < 0 || static_cast<std::size_t>(t.feature) >= nFeatures)
+        fail(atk + ": feature index " + std::to_string(t.feature) + " out of range (model has " +
+             std::to_string(nFeatures) + " features)");
+      if (!std::isfinite(t.threshold)) fail(atk + ": threshold is not finite");
+      if (!std::isfinite(t.left) || !std::isfinite(t.right)) fail(atk + ": leaf value is not finite");
+    }
+  }
+}
+
+}  // namespace fusedet::boosting

@@ -1,0 +1,224 @@
+#include "fusedet/boost/detector.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+
+
+namespace fusedet::boosting {
+
+namespace {
+
+int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
+
+// One stump with its feature laid out for one scale: rectangle corners as offsets from the
+// window's origin in its layer's integral (OpenCV's OptFeature idea), flat for the hot loop.
+struct ScaledStump {
+  int layer = 0;
+  int blackCount = 1;
+  bool whiteIsRest = false;
+  std::array<std::array<std::int32_t, 4>, 3> ofs{};  // (x0,y0) (x1,y0) (x0,y1) (x1,y1)
+  double blackArea = 1, whiteArea = 1;
+  float threshold = 0;
+  double left = 0, right = 0;
+};
+
+struct ScaledStage {
+  std::size_t begin = 0, end = 0;  // range in the stump array
+  double threshold = 0;
+};
+
+struct ScalePlan {
+  int winW = 0, winH = 0, step = 1;
+  std::vector<int> xs, ys;                       // window positions (reference pixels)
+  std::vector<std::vector<std::ptrdiff_t>> colOfs, rowOfs;  // per layer, per position
+  std::vector<ScaledStump> stumps;
+  std::vector<ScaledStage> stages;
+};
+
+std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, const ScanParams& p) {
+  if (!(p.scaleFactor > 1)) throw std::invalid_argument("scale factor must be > 1");
+  const int W = in.width(), H = in.height();
+  const int maxW = p.maxWidth > 0 ? std::min(p.maxWidth, W) : W;
+  const int maxH = p.maxHeight > 0 ? std::min(p.maxHeight, H) : H;
+  double s0 = 1.0;
+  if (p.minWidth > 0 || p.minHeight > 0)
+    s0 = std::max(double(p.minWidth) / c.windowWidth, double(p.minHeight) / c.windowHeight);
+  std::vector<ScalePlan> plans;
+  for (double s = s0;; s *= p.scaleFactor) {
+    ScalePlan sp;
+    sp.winW = std::max(1, roundHalfUp(c.windowWidth * s));
+    sp.winH = std::max(1, roundHalfUp(c.windowHeight * s));
+    if (sp.winW > maxW || sp.winH > maxH) break;
+    if (sp.winW < p.minWidth || sp.winH < p.minHeight) continue;
+    sp.step = std::max(1, roundHalfUp(p.step * s));
+    for (int x = 0; x + sp.winW <= W; x += sp.step) sp.xs.push_back(x);
+    for (int y = 0; y + sp.winH <= H; y += sp.step) sp.ys.push_back(y);
+    const std::size_t nl = in.size();
+    sp.colOfs.resize(nl);
+    sp.rowOfs.resize(nl);
+    std::vector<std::array<int, 2>> lwSize(nl);
+    for (std::size_t l = 0; l < nl; ++l) {
+      const LayerIntegral& li = in.layer(l);
+      lwSize[l] = layerWindowSize(li, W, H, sp.winW, sp.winH);
+      const double sx = double(li.width) / W, sy = double(li.height) / H;
+      for (int x : sp.xs) sp.colOfs[l].push_back(std::clamp(roundHalfUp(x * sx), 0, li.width - lwSize[l][0]));
+      for (int y : sp.ys)
+        sp.rowOfs[l].push_back(std::ptrdiff_t(std::clamp(roundHalfUp(y * sy), 0, li.height - lwSize[l][1])) *
+                               li.stride());
+    }
+    for (const Stage& st : c.stages) {
+      ScaledStage ss{sp.stumps.size(), 0, st.threshold};
+      for (const Stump& t : st.stumps) {
+        const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+        const auto l = static_cast<std::size_t>(f.layer);
+        const std::ptrdiff_t stride = in.layer(l).stride();
+        const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lwSize[l][0], lwSize[l][1]));
+        ScaledStump z;
+        z.layer = f.layer;
+        z.blackCount = lay.blackCount;
+        z.whiteIsRest = lay.whiteIsRest;
+        z.blackArea = lay.blackArea;
+        z.whiteArea = lay.whiteArea;
+        for (int i = 0; i < lay.count(); ++i) {
+          const PixelRect& r = lay.rects[static_cast<std::size_t>(i)];
+          z.ofs[static_cast<std::size_t>(i)] = {
+              static_cast<std::int32_t>(r.y0 * stride + r.x0), static_cast<std::int32_t>(r.y0 * stride + r.x1),
+              static_cast<std::int32_t>(r.y1 * stride + r.x0), static_cast<std::int32_t>(r.y1 * stride + r.x1)};
+        }
+        z.threshold = static_cast<float>(t.threshold);
+        z.left = t.left;
+        z.right = t.right;
+        sp.stumps.push_back(z);
+      }
+      ss.end = sp.stumps.size();
+      sp.stages.push_back(ss);
+    }
+    plans.push_back(std::move(sp));
+  }
+  return plans;
+}
+
+// The hot loop: same arithmetic, in the same order, as featureValue() + evaluateWindow().
+inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, std::size_t& stumps) {
+  WindowResult r;
+  for (const ScaledStage& st : sp.stages) {
+    double sum = 0;
+    for (std::size_t k = st.begin; k < st.end; ++k) {
+      const ScaledStump& z = sp.stumps[k];
+      const double* p = base[z.layer];
+      auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
+      const double black = z.blackCount == 2 ? rs(z.ofs[0]) + rs(z.ofs[1]) : rs(z.ofs[0]);
+      const double last = rs(z.ofs[static_cast<std::size_t>(z.blackCount)]);
+      const double white = z.whiteIsRest ? last - black : last;
+      const auto v = static_cast<float>(black / z.blackArea - white / z.whiteArea);
+      sum += v < z.threshold ? z.left : z.right;
+    }
+    stumps += st.end - st.begin;
+    r.score = sum;
+    if (sum < st.threshold) return r;
+    ++r.stagesPassed;
+  }
+  r.accepted = true;
+  return r;
+}
+
+template <class Body>
+void forEachRow(std::size_t rows, int threads, const Body& body) {
+  if (threads == 1) {
+    for (std::size_t i = 0; i < rows; ++i) body(i);
+    return;
+  }
+  auto run = [&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+  };
+  if (threads > 1) {
+    tbb::task_arena arena(threads);
+    arena.execute(run);
+  } else {
+    run();
+  }
+}
+
+}  // namespace
+
+WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box& window) {
+  if (c.isOpenCv())
+    throw std::invalid_argument("evaluateWindow: OpenCV models run on their image pyramid (Detector::scan)");
+  WindowResult r;
+  for (const Stage& st : c.stages) {
+    double sum = 0;
+    for (const Stump& t : st.stumps) {
+      const float v = featureValue(in, c.features[static_cast<std::size_t>(t.feature)], window);
+      sum += v < static_cast<float>(t.threshold) ? t.left : t.right;
+    }
+    r.score = sum;
+    if (sum < st.threshold) return r;
+    ++r.stagesPassed;
+  }
+  r.accepted = true;
+  return r;
+}
+
+IntegralStack integrateFor(const Cascade& c, const LayerStack& stack) {
+  return IntegralStack(stack, c.layers, c.referenceHue, false);
+}
+
+Detector::Detector(Cascade cascade) : cascade_(std::move(cascade)) { cascade_.validate(); }
+Detector::~Detector() = default;
+Detector::Detector(Detector&&) noexcept = default;
+Detector& Detector::operator=(Detector&&) noexcept = default;
+
+std::vector<RawHit> Detector::scan(const LayerStack& stack, const ScanParams& params, ScanStats* stats) const {
+  if (cascade_.isOpenCv())
+    throw std::invalid_argument(cascade_.source + ": OpenCV models are not wired into the scanner yet");
+  return scan(integrateFor(cascade_, stack), params, stats);
+}
+
+std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& params, ScanStats* stats) const {
+  if (cascade_.isOpenCv())
+    throw std::invalid_argument("Detector::scan: OpenCV models scan a LayerStack (their own pyramid)");
+  if (in.size() != cascade_.layers.size())
+    throw std::invalid_argument("Detector::scan: integrals hold " + std::to_string(in.size()) +
+                                " layers, the model reads " + std::to_string(cascade_.layers.size()));
+  const std::vector<ScalePlan> plans = planScales(cascade_, in, params);
+  // Rows of all scales in one index space so that threads share the work across scales.
+  std::vector<std::pair<std::size_t, std::size_t>> rows;
+  for (std::size_t s = 0; s < plans.size(); ++s)
+    for (std::size_t y = 0; y < plans[s].ys.size(); ++y) rows.emplace_back(s, y);
+  std::vector<std::vector<RawHit>> hits(rows.size());
+  std::vector<std::size_t> stumpCount(rows.size(), 0);
+  const std::size_t nl = in.size();
+  forEachRow(rows.size(), params.threads, [&](std::size_t i) {
+    const auto [s, yi] = rows[i];
+    const ScalePlan& sp = plans[s];
+    std::vector<const double*> base(nl);
+    std::size_t stumps = 0;
+    for (std::size_t xi = 0; xi < sp.xs.size(); ++xi) {
+      for (std::size_t l = 0; l < nl; ++l)
+        base[l] = in.layer(l).sum.data() + sp.rowOfs[l][yi] + sp.colOfs[l][xi];
+      const WindowResult r = runWindow(sp, base.data(), stumps);
+      if (r.accepted)
+        hits[i].push_back(RawHit{Box{double(sp.xs[xi]), double(sp.ys[yi]), double(sp.winW), double(sp.winH)},
+                                 r.score, static_cast<int>(s)});
+    }
+    stumpCount[i] = stumps;
+  });
+  std::vector<RawHit> out;
+  for (auto& h : hits) out.insert(out.end(), h.begin(), h.end());
+  if (stats) {
+    stats->scales += plans.size();
+    for (const ScalePlan& sp : plans) stats->windows += sp.xs.size() * sp.ys.size();
+    for (std::size_t n : stumpCount) stats->stumps += n;
+  }
+  return out;
+}
+
+}  // namespace fusedet::boosting
