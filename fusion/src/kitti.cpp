@@ -45,6 +45,32 @@ Eigen::Matrix<double, 3, 4> KittiCalib::veloToImage() const {
   return P2 * r0 * tr;
 }
 
+PinholeProjection kittiProjection(const KittiCalib& calib, int width, int height) {
+  PinholeProjection p;
+  p.K = calib.P2.leftCols<3>();
+  if (p.K(2, 0) != 0 || p.K(2, 1) != 0 || p.K(2, 2) != 1 || p.K(1, 0) != 0 || !(p.K(0, 0) > 0) || !(p.K(1, 1) > 0))
+    throw std::runtime_error("KITTI P2 is not of the form K [I | t] with K upper triangular");
+  Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+  shift.translation() = p.K.inverse() * calib.P2.col(3);
+  Eigen::Isometry3d rect = Eigen::Isometry3d::Identity();
+  rect.linear() = calib.R0rect;
+  Eigen::Isometry3d velo = Eigen::Isometry3d::Identity();
+  velo.matrix().topRows<3>() = calib.TrVeloToCam;
+  p.sweepToCamera = shift * rect * velo;
+  p.width = width;
+  p.height = height;
+  return p;
+}
+
+Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config) {
+  const PinholeProjection p = kittiProjection(calib, width, height);
+  CameraModel camera;
+  camera.width = width;
+  camera.height = height;
+  camera.K = p.K;
+  return Fuser(camera, p.sweepToCamera, config);
+}
+
 std::vector<std::string> listKittiFrames(const fs::path& root) {
   std::vector<std::string> ids;
   if (std::ifstream list(root / "ImageSets" / "all.txt"); list) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fusedet/core/label.h"
+#include "fusedet/fusion/fuser.h"
 #include "fusedet/fusion/sweep.h"
 
 namespace fusedet::fusion {
@@ -47,5 +48,12 @@ Labels readKittiLabels(const std::filesystem::path& file, const KittiClassMap& m
 Sweep readKittiVelodyne(const std::filesystem::path& file);
 KittiFrame readKittiFrame(const std::filesystem::path& root, const std::string& id,
                           const KittiClassMap& map = {});
+
+// The rectified colour camera of a KITTI frame as a pinhole + rigid transform, so KITTI goes
+// through the same projection code as live data: K = P2(:, 0:3), and the camera-2 frame is
+// [I | K^-1 P2(:, 3)] * R0_rect * Tr_velo_to_cam, hence K * (T * X) = P2 * R0_rect * Tr * X.
+PinholeProjection kittiProjection(const KittiCalib& calib, int width, int height);
+// A Fuser for a KITTI camera (no distortion: image_2 is rectified).
+Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config = {});
 
 }  // namespace fusedet::fusion

@@ -1,0 +1,53 @@
+#include "fusedet/fusion/camera_layers.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace fusedet::fusion {
+
+cv::Mat hueDegrees(const cv::Mat& bgr) {
+  if (bgr.type() != CV_8UC3) throw std::invalid_argument("hueDegrees: image must be 8-bit BGR");
+  cv::Mat hue(bgr.size(), CV_32FC1);
+  // One pass with one division per pixel; cv::cvtColor would first need a float copy of the image.
+  for (int y = 0; y < bgr.rows; ++y) {
+    const std::uint8_t* p = bgr.ptr<std::uint8_t>(y);
+    float* h = hue.ptr<float>(y);
+    for (int x = 0; x < bgr.cols; ++x, p += 3) {
+      const int b = p[0], g = p[1], r = p[2];
+      const int mx = std::max({b, g, r}), mn = std::min({b, g, r});
+      const int diff = mx - mn;
+      if (diff == 0) {
+        h[x] = 0.f;
+        continue;
+      }
+      const float k = 60.f / static_cast<float>(diff);
+      float v;
+      if (mx == r)
+        v = static_cast<float>(g - b) * k;
+      else if (mx == g)
+        v = static_cast<float>(b - r) * k + 120.f;
+      else
+        v = static_cast<float>(r - g) * k + 240.f;
+      if (v < 0.f) v += 360.f;
+      h[x] = v >= 360.f ? v - 360.f : v;
+    }
+  }
+  return hue;
+}
+
+void addCameraLayers(LayerStack& stack, const cv::Mat& bgr) {
+  if (bgr.type() != CV_8UC3) throw std::invalid_argument("addCameraLayers: image must be 8-bit BGR");
+  stack.setReferenceSize(bgr.cols, bgr.rows);
+  cv::Mat channels[3];
+  cv::split(bgr, channels);
+  cv::Mat gray;
+  cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+  stack.set(Layer{std::string(layer::kRed), channels[2], {}});
+  stack.set(Layer{std::string(layer::kGreen), channels[1], {}});
+  stack.set(Layer{std::string(layer::kBlue), channels[0], {}});
+  stack.set(Layer{std::string(layer::kIntensity), gray, {}});
+  stack.set(Layer{std::string(layer::kHue), hueDegrees(bgr), {}});
+}
+
+}  // namespace fusedet::fusion

@@ -1,0 +1,52 @@
+#include "fusedet/fusion/fuser.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "fusedet/fusion/camera_layers.h"
+
+namespace fusedet::fusion {
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+}  // namespace
+
+Fuser::Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, ProjectionConfig config)
+    : config_(config), undistorter_(camera) {
+  projection_.K = camera.K;
+  projection_.sweepToCamera = sweepToCamera;
+  projection_.width = camera.width;
+  projection_.height = camera.height;
+  (void)laserLayerSize(camera.width, camera.height, config_.laserLayerScale);  // validates the scale
+  if (config_.holeFillRadius < 0) throw std::invalid_argument("hole fill radius must be >= 0");
+}
+
+LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings) const {
+  FuseTimings t;
+  const auto start = Clock::now();
+  auto t0 = start;
+  const cv::Mat image = undistorter_.undistort(bgr);
+  t.undistortMs = msSince(t0);
+
+  t0 = Clock::now();
+  LayerStack stack;
+  addCameraLayers(stack, image);
+  t.cameraLayersMs = msSince(t0);
+
+  t0 = Clock::now();
+  const std::vector<ProjectedPoint> points = projectPoints(sweep, projection_, config_.minDepth);
+  t.projectMs = msSince(t0);
+
+  t0 = Clock::now();
+  LaserLayers laser = rasteriseLaserLayers(points, projection_.width, projection_.height, config_);
+  stack.set(std::move(laser.distance));
+  stack.set(std::move(laser.remission));
+  t.rasteriseMs = msSince(t0);
+  t.totalMs = msSince(start);
+  if (timings) *timings = t;
+  return stack;
+}
+
+}  // namespace fusedet::fusion

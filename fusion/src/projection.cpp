@@ -1,0 +1,95 @@
+#include "fusedet/fusion/projection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace fusedet::fusion {
+
+std::vector<ProjectedPoint> projectPoints(const Sweep& sweep, const PinholeProjection& pr, double minDepth) {
+  if (pr.width <= 0 || pr.height <= 0) throw std::invalid_argument("projectPoints: image size not set");
+  const Eigen::Matrix3d R = pr.sweepToCamera.linear();
+  const Eigen::Vector3d t = pr.sweepToCamera.translation();
+  const Eigen::Matrix3d& K = pr.K;
+  const double w = pr.width, h = pr.height;
+  std::vector<ProjectedPoint> out;
+  out.reserve(sweep.points.size() / 3);
+  for (std::size_t i = 0; i < sweep.points.size(); ++i) {
+    const SweepPoint& p = sweep.points[i];
+    const Eigen::Vector3d c = R * Eigen::Vector3d(p.x, p.y, p.z) + t;
+    if (!(c.z() >= minDepth)) continue;  // behind the camera, too close, or NaN
+    const double iz = 1.0 / c.z();
+    const double u = (K(0, 0) * c.x() + K(0, 1) * c.y()) * iz + K(0, 2);
+    const double v = K(1, 1) * c.y() * iz + K(1, 2);
+    if (!(u >= 0 && u < w && v >= 0 && v < h)) continue;
+    out.push_back(ProjectedPoint{static_cast<std::uint32_t>(i), static_cast<float>(u), static_cast<float>(v),
+                                 static_cast<float>(c.norm()), std::clamp(p.remission, 0.f, 1.f)});
+  }
+  return out;
+}
+
+cv::Size laserLayerSize(int width, int height, double scale) {
+  if (!(scale > 0 && scale <= 1)) throw std::invalid_argument("laser layer scale must be in (0, 1]");
+  return {std::max(1, static_cast<int>(std::lround(width * scale))),
+          std::max(1, static_cast<int>(std::lround(height * scale)))};
+}
+
+LaserLayers rasteriseLaserLayers(const std::vector<ProjectedPoint>& points, int imageWidth, int imageHeight,
+                                 const ProjectionConfig& config) {
+  const cv::Size size = laserLayerSize(imageWidth, imageHeight, config.laserLayerScale);
+  cv::Mat dist(size, CV_32FC1, cv::Scalar(0)), rem(size, CV_32FC1, cv::Scalar(0));
+  cv::Mat mask(size, CV_8UC1, cv::Scalar(0));
+  const float sx = static_cast<float>(size.width) / static_cast<float>(imageWidth);
+  const float sy = static_cast<float>(size.height) / static_cast<float>(imageHeight);
+  for (const ProjectedPoint& p : points) {
+    const int cx = std::min(static_cast<int>(p.u * sx), size.width - 1);
+    const int cy = std::min(static_cast<int>(p.v * sy), size.height - 1);
+    if (cx < 0 || cy < 0) continue;
+    std::uint8_t& m = mask.at<std::uint8_t>(cy, cx);
+    float& d = dist.at<float>(cy, cx);
+    if (m == 0 || p.distance < d) {  // z-buffer: the nearest point of a cell wins
+      m = kMaskMeasured;
+      d = p.distance;
+      rem.at<float>(cy, cx) = p.remission;
+    }
+  }
+  fillHoles({&dist, &rem}, mask, config.holeFillRadius);
+  return LaserLayers{Layer{std::string(layer::kDistance), dist, mask},
+                     Layer{std::string(layer::kRemission), rem, mask.clone()}};
+}
+
+void fillHoles(std::vector<cv::Mat*> values, cv::Mat& mask, int radius) {
+  if (radius <= 0) return;
+  // Normalised convolution: weighted sum of measured neighbours / sum of their weights. The
+  // centre weighs 0, so measured cells are never changed and empty ones take only neighbours.
+  const int k = 2 * radius + 1;
+  cv::Mat kernel(k, k, CV_32FC1);
+  for (int dy = -radius; dy <= radius; ++dy)
+    for (int dx = -radius; dx <= radius; ++dx)
+      kernel.at<float>(dy + radius, dx + radius) = (dx == 0 && dy == 0) ? 0.f : 1.f / static_cast<float>(dx * dx + dy * dy);
+  cv::Mat measured;
+  mask.convertTo(measured, CV_32F, 1.0 / kMaskMeasured);
+  cv::threshold(measured, measured, 0.99, 1.0, cv::THRESH_BINARY);  // filled cells do not propagate
+  cv::Mat weight;
+  cv::filter2D(measured, weight, CV_32F, kernel, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  std::vector<cv::Mat> sums(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    cv::Mat masked;
+    cv::multiply(*values[i], measured, masked);
+    cv::filter2D(masked, sums[i], CV_32F, kernel, cv::Point(-1, -1), 0, cv::BORDER_CONSTANT);
+  }
+  for (int y = 0; y < mask.rows; ++y) {
+    std::uint8_t* m = mask.ptr<std::uint8_t>(y);
+    const float* w = weight.ptr<float>(y);
+    for (int x = 0; x < mask.cols; ++x) {
+      if (m[x] != 0 || w[x] <= 0.f) continue;
+      m[x] = kMaskFilled;
+      for (std::size_t i = 0; i < values.size(); ++i)
+        values[i]->ptr<float>(y)[x] = sums[i].ptr<float>(y)[x] / w[x];
+    }
+  }
+}
+
+}  // namespace fusedet::fusion
