@@ -1,6 +1,7 @@
 #include "fusedet/boost/evaluation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "fusedet/core/box.h"
@@ -106,5 +107,50 @@ double fMeasure(double recall, double precision) {
 }
 
 double Counts::fMeasure() const { return boosting::fMeasure(recall(), precision()); }
+
+namespace {
+
+void computeShares(CascadeSummary& s) {
+  double total = 0;
+  for (const auto& [layer, w] : s.layerWeight) total += w;
+  s.layerWeightShare.clear();
+  for (const auto& [layer, w] : s.layerWeight) s.layerWeightShare[layer] = total > 0 ? w / total : 0.0;
+}
+
+}  // namespace
+
+CascadeSummary summarizeCascade(const Cascade& cascade) {
+  CascadeSummary s;
+  s.stages = cascade.stages.size();
+  for (const std::string& l : cascade.layers) s.layerWeight[l] = 0;  // listed even when unused
+  for (const Stage& stage : cascade.stages) {
+    for (const Stump& stump : stage.stumps) {
+      ++s.length;
+      std::string layerName = cascade.layers.empty() ? std::string("?") : cascade.layers.front();
+      if (!cascade.isOpenCv()) {
+        const Feature& f = cascade.features.at(static_cast<std::size_t>(stump.feature));
+        layerName = cascade.layers.at(static_cast<std::size_t>(f.layer));
+        if (isCorner(f.type)) ++s.cornerCount;
+      }
+      s.layerWeight[layerName] += std::abs(stump.right - stump.left);
+      ++s.layerCount[layerName];
+    }
+  }
+  computeShares(s);
+  return s;
+}
+
+CascadeSummary combineSummaries(const std::vector<CascadeSummary>& parts) {
+  CascadeSummary s;
+  for (const CascadeSummary& p : parts) {
+    s.length += p.length;
+    s.stages += p.stages;
+    s.cornerCount += p.cornerCount;
+    for (const auto& [l, w] : p.layerWeight) s.layerWeight[l] += w;
+    for (const auto& [l, n] : p.layerCount) s.layerCount[l] += n;
+  }
+  computeShares(s);
+  return s;
+}
 
 }  // namespace fusedet::boosting

@@ -190,5 +190,50 @@ TEST(Evaluation, FMeasureReproducesThePapersTables) {
   EXPECT_EQ(fMeasure(0, 0), 0.0);
 }
 
+Cascade twoLayerCascade() {
+  Cascade c;
+  c.className = "car";
+  c.layers = {"intensity", "distance", "remission"};
+  const int edge = c.addFeature({FeatureType::kEdgeHorizontal, {0, 0, 1, 1}, 0});
+  const int corner = c.addFeature({FeatureType::kCornerTopLeft, {0.1, 0.1, 0.5, 0.5}, 1});
+  Stage s1;
+  s1.stumps = {Stump{edge, 0.5, -0.8, 0.6}, Stump{corner, 1.0, 0.9, -0.1}};  // weights 1.4, 1.0
+  s1.threshold = 0;
+  Stage s2;
+  s2.stumps = {Stump{corner, 2.0, -0.3, 0.3}};  // weight 0.6
+  s2.threshold = 0.1;
+  c.stages = {s1, s2};
+  return c;
+}
+
+TEST(CascadeSummary, WeightIsTheLeafDifferenceSummedPerLayer) {
+  const CascadeSummary s = summarizeCascade(twoLayerCascade());
+  EXPECT_EQ(s.length, 3u);
+  EXPECT_EQ(s.stages, 2u);
+  EXPECT_NEAR(s.layerWeight.at("intensity"), 1.4, 1e-12);
+  EXPECT_NEAR(s.layerWeight.at("distance"), 1.6, 1e-12);
+  EXPECT_EQ(s.layerWeight.at("remission"), 0.0);  // listed although unused
+  EXPECT_NEAR(s.layerWeightShare.at("intensity"), 1.4 / 3.0, 1e-12);
+  EXPECT_NEAR(s.layerWeightShare.at("distance"), 1.6 / 3.0, 1e-12);
+  EXPECT_EQ(s.layerCount.at("distance"), 2u);
+  EXPECT_EQ(s.cornerCount, 2u);
+  EXPECT_NEAR(s.cornerShare(), 2.0 / 3.0, 1e-12);
+}
+
+TEST(CascadeSummary, CombiningAddsLengthsAndReweights) {
+  Cascade camera;
+  camera.layers = {"intensity"};
+  const int f = camera.addFeature({FeatureType::kLineVertical, {0, 0, 1, 1}, 0});
+  Stage st;
+  st.stumps = {Stump{f, 0, -1, 1}};  // weight 2
+  camera.stages = {st};
+  const CascadeSummary both = combineSummaries({summarizeCascade(twoLayerCascade()), summarizeCascade(camera)});
+  EXPECT_EQ(both.length, 4u);
+  EXPECT_EQ(both.stages, 3u);
+  EXPECT_NEAR(both.layerWeight.at("intensity"), 3.4, 1e-12);
+  EXPECT_NEAR(both.layerWeightShare.at("intensity"), 3.4 / 5.0, 1e-12);
+  EXPECT_NEAR(both.cornerShare(), 0.5, 1e-12);
+}
+
 }  // namespace
 }  // namespace fusedet::boosting

@@ -15,9 +15,11 @@
 // detection on the same object is a false alarm.
 
 #include <cstddef>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "fusedet/boost/cascade.h"
 #include "fusedet/core/detection.h"
 #include "fusedet/core/label.h"
 
@@ -67,5 +69,25 @@ struct Counts {
   // Harmonic mean of recall and precision; 0 when both are 0.
   double fMeasure() const;
 };
+
+// What a cascade is made of (paper §4, Fig. 7). The weight of a stump is |right - left|, the
+// amount it moves the stage sum between its two sides; its mean (left + right) / 2 is a constant
+// that only shifts the stage threshold, so it says nothing about what the layer contributes.
+// Gentle AdaBoost has no per-round alpha: the leaves are the weighted means themselves.
+struct CascadeSummary {
+  std::size_t length = 0;  // weak classifiers (stumps) over all stages
+  std::size_t stages = 0;
+  std::map<std::string, double> layerWeight;       // layer -> summed stump weight
+  std::map<std::string, double> layerWeightShare;  // layer -> weight / total weight (sums to 1)
+  std::map<std::string, std::size_t> layerCount;   // layer -> stumps on it
+  std::size_t cornerCount = 0;                     // stumps on corner-like features (g-j)
+  double cornerShare() const { return length ? double(cornerCount) / double(length) : 0.0; }
+};
+
+// Summary of one cascade. Imported OpenCV models have one layer and no corner features.
+CascadeSummary summarizeCascade(const Cascade& cascade);
+// Summary of several cascades used together (the AND combination): lengths, stages, weights and
+// counts add up; shares are recomputed over the sum.
+CascadeSummary combineSummaries(const std::vector<CascadeSummary>& parts);
 
 }  // namespace fusedet::boosting

@@ -1,0 +1,162 @@
+// `fusedet experiments` helpers: the split, the class rules and counts (checked against the counts
+// the data set's SOURCE.md states), the peers on a real frame, and the report writers.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "../../tools/experiments_data.h"
+#include "../../tools/experiments_peers.h"
+#include "../../tools/experiments_report.h"
+#include "fusedet/fusion/kitti.h"
+
+namespace fusedet::tools::experiments {
+namespace {
+namespace fs = std::filesystem;
+
+std::vector<DatasetEntry> entries(const std::string& group, int n) {
+  std::vector<DatasetEntry> e;
+  for (int i = 0; i < n; ++i) e.push_back({group + "/" + std::to_string(i), group});
+  return e;
+}
+
+TEST(ExperimentsSplit, FirstTwoThirdsOfEachGroupTrain) {
+  auto all = entries("kitti", 52);
+  const auto b = entries("kitti_0009", 26);
+  const auto c = entries("object", 3);
+  all.insert(all.end(), b.begin(), b.end());
+  all.insert(all.end(), c.begin(), c.end());
+  const Split s = splitByFrame(all);
+  // round(52 * 2/3) = 35, round(26 * 2/3) = 17, round(3 * 2/3) = 2.
+  EXPECT_EQ(s.train.size(), 35u + 17u + 2u);
+  EXPECT_EQ(s.test.size(), 17u + 9u + 1u);
+  EXPECT_EQ(s.train[34].id, "kitti/34");
+  EXPECT_EQ(s.test[0].id, "kitti/35");
+  EXPECT_EQ(s.test[17].id, "kitti_0009/17");
+  EXPECT_EQ(s.test.back().id, "object/2");
+  EXPECT_THROW(splitByFrame(all, 1.5), std::invalid_argument);
+}
+
+TEST(ExperimentsSplit, InterleavedGroupsKeepTheirOrder) {
+  const std::vector<DatasetEntry> e{{"a/0", "a"}, {"b/0", "b"}, {"a/1", "a"}, {"b/1", "b"}, {"a/2", "a"}};
+  const Split s = splitByFrame(e);
+  ASSERT_EQ(s.train.size(), 3u);  // a: round(2) = 2, b: round(1.33) = 1
+  EXPECT_EQ(s.train[0].id, "a/0");
+  EXPECT_EQ(s.train[1].id, "a/1");
+  EXPECT_EQ(s.train[2].id, "b/0");
+  EXPECT_EQ(s.test[0].id, "a/2");
+}
+
+TEST(ExperimentsRules, VanPolicyAndTrainingLabels) {
+  EXPECT_EQ(parseVanPolicy("ignore"), VanPolicy::kIgnore);
+  EXPECT_THROW(parseVanPolicy("maybe"), std::invalid_argument);
+  Labels labels(4);
+  labels[0].className = "car";  labels[0].box = {0, 0, 50, 40};
+  labels[1].className = "car";  labels[1].box = {0, 0, 20, 10};   // below 25 px
+  labels[2].className = "van";  labels[2].box = {0, 0, 60, 50};
+  labels[3].className = "DontCare"; labels[3].ignore = true;
+  const Labels neg = trainingLabels(labels, matchConfigFor("car", VanPolicy::kNegative));
+  ASSERT_EQ(neg.size(), 3u);  // the van is gone: negative material
+  EXPECT_FALSE(neg[0].ignore);
+  EXPECT_TRUE(neg[1].ignore);
+  EXPECT_TRUE(neg[2].ignore);
+  const Labels pos = trainingLabels(labels, matchConfigFor("car", VanPolicy::kPositive));
+  ASSERT_EQ(pos.size(), 4u);
+  EXPECT_EQ(pos[2].className, "car");
+  EXPECT_FALSE(pos[2].ignore);
+  const Labels ign = trainingLabels(labels, matchConfigFor("car", VanPolicy::kIgnore));
+  EXPECT_TRUE(ign[2].ignore);
+  // For person, cars and vans are background: removed.
+  EXPECT_EQ(trainingLabels(labels, matchConfigFor("person", VanPolicy::kNegative)).size(), 1u);
+}
+
+fs::path kittiDir() { return fs::path(FUSEDET_DATA_DIR) / "kitti"; }
+
+TEST(ExperimentsRules, CountsMatchTheDataSetsSourceNotes) {
+  if (!fs::is_directory(kittiDir())) GTEST_SKIP() << "no KITTI data at " << kittiDir();
+  std::vector<Labels> frames;
+  for (const auto& id : fusion::listKittiFrames(kittiDir()))
+    frames.push_back(fusion::readKittiLabels(kittiDir() / "label_2" / (id + ".txt")));
+  // SOURCE.md: "Car 82, Van 99, Cyclist 52, Pedestrian 8"; frames: Car 15, Cyclist 52, Pedestrian 8.
+  boosting::MatchConfig every = matchConfigFor("car", VanPolicy::kNegative);
+  every.minHeight = 0;
+  every.maxOcclusion = 3;
+  InstanceCount car = countInstances(frames, every);
+  EXPECT_EQ(car.positives, 82u);
+  EXPECT_EQ(car.frames, 15u);
+  every.className = "bike";
+  EXPECT_EQ(countInstances(frames, every).positives, 52u);
+  every.className = "person";
+  const InstanceCount person = countInstances(frames, every);
+  EXPECT_EQ(person.positives, 8u);
+  EXPECT_EQ(person.frames, 8u);
+  every.className = "car";
+  every.aliasClasses = {"van"};
+  EXPECT_EQ(countInstances(frames, every).positives, 82u + 99u);
+  // Moderate rules only drop labels, they never add any.
+  const InstanceCount moderate = countInstances(frames, matchConfigFor("car", VanPolicy::kNegative));
+  EXPECT_EQ(moderate.positives + moderate.ignoredLabels, 82u);
+}
+
+TEST(ExperimentsPeers, RunOnARealFrame) {
+  if (!fs::is_directory(kittiDir())) GTEST_SKIP() << "no KITTI data at " << kittiDir();
+  const fusion::KittiFrame f = fusion::readKittiFrame(kittiDir(), "000000");
+  LayerStack stack(f.image.cols, f.image.rows);
+  std::vector<cv::Mat> bgr;
+  cv::split(f.image, bgr);
+  stack.set({"red", bgr[2], {}});
+  stack.set({"green", bgr[1], {}});
+  stack.set({"blue", bgr[0], {}});
+  const cv::Mat back = stackToBgr(stack);
+  EXPECT_EQ(cv::norm(back, f.image, cv::NORM_INF), 0.0);
+  for (const auto& peer : {makeHogPeer(1.0), makeHaarFullbodyPeer(defaultHaarFullbodyPath(), 1.0)}) {
+    for (const Detection& d : peer->detect(back)) {
+      EXPECT_EQ(d.className, "person");
+      EXPECT_GE(d.box.x, -1);
+      EXPECT_LE(d.box.right(), f.image.cols + 1) << peer->name();
+      EXPECT_GT(d.box.h, d.box.w) << peer->name() << ": people detectors find upright boxes";
+    }
+  }
+  EXPECT_THROW(makeHaarFullbodyPeer("/nonexistent/cascade.xml"), std::runtime_error);
+}
+
+TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
+  ExperimentReport r;
+  r.command = "fusedet experiments --quick";
+  r.classes = {"car"};
+  auto add = [&](std::string config, std::size_t hits, std::size_t fa, std::size_t len) {
+    ConfigResult c;
+    c.className = "car";
+    c.config = std::move(config);
+    c.length = len;
+    c.counts.positives = 10;
+    c.counts.hits = hits;
+    c.counts.misses = 10 - hits;
+    c.counts.falseAlarms = fa;
+    c.layerWeightShare = {{"distance", 0.75}, {"intensity", 0.25}};
+    r.results.push_back(c);
+  };
+  add("all", 9, 1, 20);     // F = 0.9
+  add("laser", 9, 3, 30);   // R .9 P .75 -> F .818
+  add("camera", 10, 0, 40); // F = 1
+  const nlohmann::json j = toJson(r);
+  EXPECT_NEAR(j["results"][0]["f_measure"].get<double>(), 0.9, 1e-12);
+  EXPECT_EQ(j["results"][0]["length"].get<int>(), 20);
+  EXPECT_TRUE(j["claims"]["car"]["joint_ge_laser"]["holds"].get<bool>());
+  EXPECT_FALSE(j["claims"]["car"]["joint_ge_camera"]["holds"].get<bool>());
+  EXPECT_TRUE(j["claims"]["car"]["joint_ge_and"].is_null());
+  const std::string md = renderMarkdown(r);
+  EXPECT_NE(md.find("### Tab. 2: all layers"), std::string::npos);
+  EXPECT_NE(md.find("| F-measure | 0.90 |"), std::string::npos) << md;
+  EXPECT_NE(md.find("joint pool (all layers) >= camera only: **does not hold** (F 0.90 vs 1.00"), std::string::npos);
+  EXPECT_EQ(md.find("Tab. 7"), std::string::npos);  // not evaluated, no table
+  // Fig. 7 chart: distance (laser) bar three times as high as intensity's.
+  const cv::Mat chart = weightShareChart("car", r.results[0].layerWeightShare);
+  ASSERT_FALSE(chart.empty());
+  EXPECT_EQ(orderedLayers(r.results[0].layerWeightShare), (std::vector<std::string>{"intensity", "distance"}));
+}
+
+}  // namespace
+}  // namespace fusedet::tools::experiments
