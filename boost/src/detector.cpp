@@ -1,5 +1,7 @@
 #include "fusedet/boost/detector.h"
 
+#include "opencv_pyramid.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -177,8 +179,7 @@ Detector::Detector(Detector&&) noexcept = default;
 Detector& Detector::operator=(Detector&&) noexcept = default;
 
 std::vector<RawHit> Detector::scan(const LayerStack& stack, const ScanParams& params, ScanStats* stats) const {
-  if (cascade_.isOpenCv())
-    throw std::invalid_argument(cascade_.source + ": OpenCV models are not wired into the scanner yet");
+  if (cascade_.isOpenCv()) return scanOpenCvPyramid(cascade_, stack, params, stats);
   return scan(integrateFor(cascade_, stack), params, stats);
 }
 

@@ -1,0 +1,38 @@
+#pragma once
+// From raw window hits to detections, two ways:
+//  - kOpenCv: cv::groupRectangles' rule - hits whose four edges lie within eps * mean(min width,
+//    min height) / 2 of each other are linked, linked sets form groups (transitively), a group
+//    becomes its average rectangle if it has more than minNeighbors members, and groups that sit
+//    inside a bigger, better supported group are dropped. Score = members in the group.
+//    minNeighbors <= 0 returns every hit unchanged (OpenCV's behaviour).
+//  - kNms: greedy non-maximum suppression by score (the last stage's sum): a hit is dropped when it
+//    overlaps an already kept one with IoU > iouThreshold. Score = the hit's score.
+// Output order is deterministic: groups by their first hit, NMS by descending score then index.
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/detector.h"
+#include "fusedet/core/detection.h"
+#include "fusedet/core/layer_stack.h"
+
+namespace fusedet::boosting {
+
+struct GroupParams {
+  enum class Method { kOpenCv, kNms };
+  Method method = Method::kOpenCv;
+  int minNeighbors = 3;        // kOpenCv
+  double eps = 0.2;            // kOpenCv (OpenCV's GROUP_EPS)
+  double iouThreshold = 0.5;   // kNms
+};
+
+// Detections for `className` in `stack` (boxes in its reference pixels, unitBox, stamp, stackId).
+std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams& params,
+                                 const std::string& className, const LayerStack& stack);
+
+// Scan + group in one call.
+std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
+                              const GroupParams& group);
+
+}  // namespace fusedet::boosting

@@ -1,0 +1,32 @@
+#pragma once
+// Import of OpenCV Haar cascades as Debian's opencv-data ships them
+// (/usr/share/opencv4/haarcascades): the current format (<cascade> with stageType BOOST,
+// featureType HAAR, stages/weakClassifiers/internalNodes/leafValues, features/rects/tilted) and
+// the old one (type_id "opencv-haar-classifier": <size>, stages/trees with inline features),
+// which OpenCV converts to the same model on load.
+//
+// The result is a Cascade with Normalization::kOpenCvVariance, one layer (default "intensity")
+// and OpenCV's load-time conventions applied, so that decisions match cv::CascadeClassifier bit
+// for bit: thresholds and leaves rounded to float, leaves below 1e-5 in magnitude set to 0, stage
+// thresholds lowered by 1e-5 (OpenCV's THRESHOLD_EPS).
+//
+// Weak classifiers must be stumps (one split); cascades of deeper trees (alt2, *_2splits,
+// eye_tree_eyeglasses) and LBP/HOG cascades are rejected with a clear message.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "fusedet/boost/cascade.h"
+
+namespace fusedet::boosting {
+
+// Throws std::runtime_error "FILE: line N: problem" for unreadable, malformed or inconsistent
+// files (truncated XML, wrong counts, non-finite numbers, unknown feature or stage types,
+// indices or rectangles out of range).
+Cascade loadOpenCvCascade(const std::filesystem::path& file, const std::string& layer = "intensity");
+// Same from text; `source` names it in messages.
+Cascade parseOpenCvCascade(std::string_view xml, const std::string& source,
+                           const std::string& layer = "intensity");
+
+}  // namespace fusedet::boosting

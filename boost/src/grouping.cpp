@@ -1,0 +1,139 @@
+#include "fusedet/boost/grouping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace fusedet::boosting {
+
+namespace {
+
+struct IRect {
+  int x = 0, y = 0, w = 0, h = 0;
+};
+
+IRect toInt(const Box& b) {
+  return {static_cast<int>(std::lrint(b.x)), static_cast<int>(std::lrint(b.y)), static_cast<int>(std::lrint(b.w)),
+          static_cast<int>(std::lrint(b.h))};
+}
+
+bool similar(const IRect& a, const IRect& b, double eps) {
+  const double delta = eps * (std::min(a.w, b.w) + std::min(a.h, b.h)) * 0.5;
+  return std::abs(a.x - b.x) <= delta && std::abs(a.y - b.y) <= delta &&
+         std::abs(a.x + a.w - b.x - b.w) <= delta && std::abs(a.y + a.h - b.y - b.h) <= delta;
+}
+
+int find(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+Detection makeDetection(const Box& box, double score, const std::string& className, const LayerStack& stack) {
+  Detection d;
+  d.className = className;
+  d.score = score;
+  d.box = box;
+  if (stack.width() > 0 && stack.height() > 0) d.unitBox = stack.toUnit(box);
+  d.stamp = stack.stamp;
+  d.stackId = stack.id;
+  return d;
+}
+
+std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupParams& p, const std::string& cls,
+                                   const LayerStack& stack) {
+  std::vector<Detection> out;
+  if (p.minNeighbors <= 0) {
+    for (const RawHit& h : hits) out.push_back(makeDetection(h.box, 1, cls, stack));
+    return out;
+  }
+  const int n = static_cast<int>(hits.size());
+  std::vector<IRect> r(hits.size());
+  for (std::size_t i = 0; i < hits.size(); ++i) r[i] = toInt(hits[i].box);
+  std::vector<int> parent(hits.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (similar(r[static_cast<std::size_t>(i)], r[static_cast<std::size_t>(j)], p.eps)) {
+        const int a = find(parent, i), b = find(parent, j);
+        if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+      }
+  // Classes numbered by their first member, as cv::partition numbers them.
+  std::vector<int> label(hits.size(), -1), rootLabel(hits.size(), -1);
+  int classes = 0;
+  for (int i = 0; i < n; ++i) {
+    const int root = find(parent, i);
+    if (rootLabel[static_cast<std::size_t>(root)] < 0) rootLabel[static_cast<std::size_t>(root)] = classes++;
+    label[static_cast<std::size_t>(i)] = rootLabel[static_cast<std::size_t>(root)];
+  }
+  std::vector<std::array<long long, 4>> sums(static_cast<std::size_t>(classes), {0, 0, 0, 0});
+  std::vector<int> count(static_cast<std::size_t>(classes), 0);
+  for (int i = 0; i < n; ++i) {
+    auto& s = sums[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])];
+    const IRect& q = r[static_cast<std::size_t>(i)];
+    s[0] += q.x, s[1] += q.y, s[2] += q.w, s[3] += q.h;
+    ++count[static_cast<std::size_t>(label[static_cast<std::size_t>(i)])];
+  }
+  // Average in float and round like OpenCV (saturate_cast<int>(sum * (1.f / n))).
+  std::vector<IRect> avg(static_cast<std::size_t>(classes));
+  for (std::size_t c = 0; c < avg.size(); ++c) {
+    const float s = 1.f / static_cast<float>(count[c]);
+    auto rnd = [s](long long v) { return static_cast<int>(std::lrintf(static_cast<float>(v) * s)); };
+    avg[c] = {rnd(sums[c][0]), rnd(sums[c][1]), rnd(sums[c][2]), rnd(sums[c][3])};
+  }
+  for (std::size_t i = 0; i < avg.size(); ++i) {
+    const IRect& r1 = avg[i];
+    const int n1 = count[i];
+    if (n1 <= p.minNeighbors) continue;
+    bool inside = false;
+    for (std::size_t j = 0; j < avg.size() && !inside; ++j) {
+      const int n2 = count[j];
+      if (j == i || n2 <= p.minNeighbors) continue;
+      const IRect& r2 = avg[j];
+      const int dx = static_cast<int>(std::lrint(r2.w * p.eps)), dy = static_cast<int>(std::lrint(r2.h * p.eps));
+      inside = r1.x >= r2.x - dx && r1.y >= r2.y - dy && r1.x + r1.w <= r2.x + r2.w + dx &&
+               r1.y + r1.h <= r2.y + r2.h + dy && (n2 > std::max(3, n1) || n1 < 3);
+    }
+    if (!inside) out.push_back(makeDetection(Box{double(r1.x), double(r1.y), double(r1.w), double(r1.h)}, n1, cls, stack));
+  }
+  return out;
+}
+
+std::vector<Detection> groupNms(std::span<const RawHit> hits, const GroupParams& p, const std::string& cls,
+                                const LayerStack& stack) {
+  std::vector<std::size_t> order(hits.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return hits[a].score > hits[b].score; });
+  std::vector<Detection> out;
+  std::vector<Box> kept;
+  for (std::size_t i : order) {
+    bool suppressed = false;
+    for (const Box& k : kept)
+      if (iou(hits[i].box, k) > p.iouThreshold) {
+        suppressed = true;
+        break;
+      }
+    if (suppressed) continue;
+    kept.push_back(hits[i].box);
+    out.push_back(makeDetection(hits[i].box, hits[i].score, cls, stack));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams& params, const std::string& className,
+                                 const LayerStack& stack) {
+  return params.method == GroupParams::Method::kNms ? groupNms(hits, params, className, stack)
+                                                    : groupOpenCv(hits, params, className, stack);
+}
+
+std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
+                              const GroupParams& group) {
+  const std::vector<RawHit> hits = detector.scan(stack, scan);
+  return groupHits(hits, group, detector.cascade().className, stack);
+}
+
+}  // namespace fusedet::boosting

@@ -1,0 +1,123 @@
+// Parity with cv::CascadeClassifier (the peer): the five cascades of the issue on real photos
+// (opencv-doc's examples) and KITTI frames. Raw window decisions are compared with OpenCV's raw
+// candidates (minNeighbors 0), grouped detections (minNeighbors 3) one-to-one at IoU >= 0.9.
+// Prints the agreement figures.
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/objdetect.hpp>
+#include <set>
+#include <tuple>
+
+#include "fusedet/boost/grouping.h"
+#include "fusedet/boost/opencv_cascade.h"
+
+using namespace fusedet;
+using namespace fusedet::boosting;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kCascades = "/usr/share/opencv4/haarcascades";
+const fs::path kPhotos = "/usr/share/doc/opencv-doc/examples/data";
+const fs::path kData = FUSEDET_DATA_DIR;
+
+std::vector<fs::path> images() {
+  return {kPhotos / "messi5.jpg", kPhotos / "baboon.jpg", kPhotos / "home.jpg", kPhotos / "squirrel_cls.jpg",
+          kPhotos / "building.jpg", kData / "kitti" / "image_2" / "000000.png",
+          kData / "kitti_0009" / "image_2" / "000010.png"};
+}
+
+using RectKey = std::tuple<int, int, int, int>;
+
+struct Totals {
+  std::size_t windows = 0, disagreements = 0, ourHits = 0, cvHits = 0, groupsCv = 0, groupsMatched = 0,
+              groupsOurs = 0;
+};
+
+
+Totals runCascade(const std::string& name, bool printEach) {
+  Totals t;
+  const fs::path file = kCascades / name;
+  cv::CascadeClassifier cv;
+  EXPECT_TRUE(cv.load(file.string())) << file;
+  const Detector det(loadOpenCvCascade(file));
+  for (const fs::path& img : images()) {
+    const cv::Mat bgr = cv::imread(img.string(), cv::IMREAD_COLOR);
+    EXPECT_FALSE(bgr.empty()) << "cannot read " << img;
+    if (bgr.empty()) continue;
+    cv::Mat gray;
+    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+    std::vector<cv::Rect> raw;
+    cv.detectMultiScale(gray, raw, 1.1, 0, 0, cv::Size());
+    LayerStack stack(gray.cols, gray.rows);
+    stack.set(Layer{"intensity", gray, {}});
+    ScanParams p;
+    p.scaleFactor = 1.1;
+    ScanStats stats;
+    const std::vector<RawHit> hits = det.scan(stack, p, &stats);
+    std::multiset<RectKey> theirs, ours;
+    for (const cv::Rect& r : raw) theirs.insert({r.x, r.y, r.width, r.height});
+    for (const RawHit& h : hits) ours.insert({int(h.box.x), int(h.box.y), int(h.box.w), int(h.box.h)});
+    std::vector<RectKey> diff;
+    std::set_symmetric_difference(ours.begin(), ours.end(), theirs.begin(), theirs.end(), std::back_inserter(diff));
+    // Grouped: OpenCV's own grouping of its candidates vs ours of our hits.
+    std::vector<cv::Rect> cvGrouped = raw;
+    cv::groupRectangles(cvGrouped, 3, 0.2);
+    GroupParams g;
+    g.minNeighbors = 3;
+    const auto mine = groupHits(hits, g, "x", stack);
+    std::vector<bool> used(mine.size(), false);
+    std::size_t matched = 0;
+    for (const cv::Rect& r : cvGrouped) {
+      const Box b{double(r.x), double(r.y), double(r.width), double(r.height)};
+      for (std::size_t i = 0; i < mine.size(); ++i)
+        if (!used[i] && iou(b, mine[i].box) >= 0.9) {
+          used[i] = true;
+          ++matched;
+          break;
+        }
+    }
+    t.windows += stats.windows;
+    t.disagreements += diff.size();
+    t.ourHits += hits.size();
+    t.cvHits += raw.size();
+    t.groupsCv += cvGrouped.size();
+    t.groupsOurs += mine.size();
+    t.groupsMatched += matched;
+    if (printEach)
+      std::printf("parity %-36s %-18s windows %8zu  hits ours %5zu opencv %5zu  differ %3zu  groups %2zu/%2zu matched %2zu\n",
+                  name.c_str(), img.filename().c_str(), stats.windows, hits.size(), raw.size(), diff.size(), mine.size(),
+                  cvGrouped.size(), matched);
+  }
+  return t;
+}
+
+void checkParity(const std::string& name) {
+  const Totals t = runCascade(name, true);
+  const double agreement = t.windows ? 1.0 - double(t.disagreements) / double(t.windows) : 0.0;
+  std::printf("parity %s: window agreement %.6f (%zu of %zu windows differ), raw hits ours %zu opencv %zu, "
+              "grouped %zu/%zu matched 1:1 at IoU>=0.9 (ours %zu)\n",
+              name.c_str(), agreement, t.disagreements, t.windows, t.ourHits, t.cvHits, t.groupsMatched, t.groupsCv,
+              t.groupsOurs);
+  EXPECT_GT(t.windows, 100000u);
+  EXPECT_GT(t.cvHits, 0u) << "the photos should give OpenCV some candidates";
+  EXPECT_GE(agreement, 0.999);
+  EXPECT_EQ(t.groupsMatched, t.groupsCv);
+  EXPECT_EQ(t.groupsOurs, t.groupsCv);
+}
+
+}  // namespace
+
+TEST(OpenCvParity, FrontalFaceDefault) { checkParity("haarcascade_frontalface_default.xml"); }
+TEST(OpenCvParity, FrontalFaceAlt) { checkParity("haarcascade_frontalface_alt.xml"); }
+TEST(OpenCvParity, ProfileFace) { checkParity("haarcascade_profileface.xml"); }
+TEST(OpenCvParity, Eye) { checkParity("haarcascade_eye.xml"); }
+TEST(OpenCvParity, FrontalCatFace) { checkParity("haarcascade_frontalcatface.xml"); }
+TEST(OpenCvParity, FullBodyWithTiltedFeatures) { checkParity("haarcascade_fullbody.xml"); }
+TEST(OpenCvParity, OldFormatLicencePlate) { checkParity("haarcascade_licence_plate_rus_16stages.xml"); }
