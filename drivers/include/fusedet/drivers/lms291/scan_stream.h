@@ -1,0 +1,64 @@
+#pragma once
+// ScanStream: runs an Lms291 on its own thread and keeps it running. When the port vanishes
+// (USB adapter unplugged) or the device falls silent, it closes, waits (back-off doubling from
+// 50 ms up to reconnectMax) and re-initialises from scratch. stop() ends streaming, returns the
+// device to 9600 baud and joins the thread.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "fusedet/drivers/lms291/lms291.h"
+
+namespace fusedet::drivers::lms291 {
+
+enum class StreamState { kStopped, kConnecting, kStreaming, kBackingOff };
+std::string_view toString(StreamState s);
+
+struct ScanStreamCounters {
+  Lms291Counters device;
+  std::uint64_t reconnects = 0;     // re-initialisations after the first
+  std::uint64_t failedInits = 0;
+  std::string lastError;
+};
+
+class ScanStream {
+ public:
+  using ScanHandler = std::function<void(const LaserScan&)>;
+  ScanStream(Lms291Config config, ScanHandler onScan,
+             std::chrono::milliseconds reconnectMax = std::chrono::milliseconds(5000),
+             std::chrono::milliseconds silenceLimit = std::chrono::milliseconds(1000));
+  ~ScanStream();
+  ScanStream(const ScanStream&) = delete;
+  ScanStream& operator=(const ScanStream&) = delete;
+
+  void start();
+  // Streaming off, device back to 9600 (if reachable), thread joined. Returns the result of
+  // the device stop (ok if the device was not connected).
+  Result<void> stop();
+
+  StreamState state() const { return state_.load(); }
+  ScanStreamCounters counters() const;
+
+ private:
+  void run();
+  bool sleepFor(std::chrono::milliseconds d);  // false if stop() was called
+
+  Lms291 device_;
+  ScanHandler onScan_;
+  std::chrono::milliseconds reconnectMax_;
+  std::chrono::milliseconds silenceLimit_;
+  std::atomic<StreamState> state_{StreamState::kStopped};
+  std::atomic<bool> running_{false};
+  std::thread thread_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  ScanStreamCounters counters_;
+  Result<void> stopResult_;
+};
+
+}  // namespace fusedet::drivers::lms291

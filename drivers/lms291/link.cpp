@@ -1,0 +1,134 @@
+#include "fusedet/drivers/lms291/link.h"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <thread>
+
+#include "fusedet/drivers/lms291/protocol.h"
+
+namespace fusedet::drivers::lms291 {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+// After a NAK the device wants >= 30 ms before the request is sent again (§2).
+constexpr auto kNakPause = std::chrono::milliseconds(30);
+}  // namespace
+
+Result<void> Link::open(const std::string& path, int baud) {
+  auto port = SerialPort::open(path, baud);
+  if (!port) return port.error();
+  port_ = std::move(*port);
+  reader_.clear();
+  if (forceTermios2_) return port_.setBaud(baud, true);
+  return {};
+}
+
+void Link::close() {
+  port_.close();
+  reader_.clear();
+}
+
+Result<void> Link::setBaud(int baud) {
+  auto r = port_.setBaud(baud, forceTermios2_);
+  reader_.clear();
+  port_.flushInput();
+  return r;
+}
+
+void Link::flushInput() {
+  port_.flushInput();
+  reader_.clear();
+}
+
+LinkCounters Link::counters() const {
+  LinkCounters c = counters_;
+  c.reader = reader_.counters();
+  return c;
+}
+
+Result<std::optional<StreamEvent>> Link::nextEvent(Clock::time_point deadline) {
+  // The LMS leaves at most 14 ms between the bytes of a telegram: a longer silence means a
+  // pending "frame" was garbage (e.g. a stray STX with a large length).
+  const auto gap = std::chrono::microseconds(
+      std::max<std::int64_t>(20'000, static_cast<std::int64_t>(byteSeconds(std::max(port_.baud(), 1)) * 1e6 * 20)));
+  std::array<std::uint8_t, 4096> buffer{};
+  for (;;) {
+    if (auto e = reader_.next()) return std::optional<StreamEvent>(std::move(*e));
+    const auto now = Clock::now();
+    if (now >= deadline) return std::optional<StreamEvent>();
+    const auto wait = std::min<std::chrono::microseconds>(
+        gap, std::chrono::duration_cast<std::chrono::microseconds>(deadline - now));
+    auto n = port_.read(buffer, wait);
+    if (!n) return n.error();
+    if (*n == 0) {
+      if (wait == gap) reader_.expirePending();
+      continue;
+    }
+    const Stamp stamp = Stamp::now();
+    const std::span<const std::uint8_t> chunk(buffer.data(), *n);
+    if (rawHook_) rawHook_(chunk, stamp);
+    reader_.feed(chunk, stamp);
+  }
+}
+
+Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_t> data, const RequestOptions& o) {
+  const std::vector<std::uint8_t> bytes = encodeRequest(command, data);
+  const std::uint8_t expected = command | kReplyBit;
+  ++counters_.requests;
+  for (int attempt = 0; attempt <= o.retries; ++attempt) {
+    if (attempt > 0) ++counters_.retries;
+    // Line time of the request itself: at 9600 baud a long request takes tens of ms.
+    const auto sendTime = std::chrono::microseconds(static_cast<std::int64_t>(byteSeconds(port_.baud()) * 1e6 * bytes.size()));
+    if (auto w = port_.write(bytes, std::chrono::seconds(1) + sendTime); !w) return w.error();
+    bool acked = false, nak = false;
+    auto deadline = Clock::now() + o.ackTimeout + sendTime;
+    for (;;) {
+      auto ev = nextEvent(deadline);
+      if (!ev) return ev.error();
+      if (!*ev) {
+        ++counters_.timeouts;
+        break;
+      }
+      const StreamEvent& e = **ev;
+      if (e.kind == StreamEvent::Kind::kAckByte) {
+        if (!acked) deadline = Clock::now() + o.replyTimeout;
+        acked = true;
+      } else if (e.kind == StreamEvent::Kind::kNakByte) {
+        ++counters_.naks;
+        nak = true;
+        break;
+      } else if (e.kind == StreamEvent::Kind::kTelegram) {
+        const std::uint8_t c = e.telegram.command;
+        if (c == expected || o.acceptAnyTelegram) return e.telegram;
+        if (c == kUnknownCommandReply)
+        {
+          char what[64];
+          std::snprintf(what, sizeof what, "command 0x%02X refused as unknown (0x92)", command);
+          return makeError(std::errc::operation_not_supported, what);
+        }
+        ++counters_.passedOver;
+      }
+      // kBadCrc: maybe our reply, maybe noise; keep waiting until the deadline.
+    }
+    if (nak) std::this_thread::sleep_for(kNakPause);
+  }
+  char what[64];
+  std::snprintf(what, sizeof what, "no reply to command 0x%02X after %d attempts", command, o.retries + 1);
+  return makeError(std::errc::timed_out, what);
+}
+
+Result<Telegram> Link::receive(std::chrono::microseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  for (;;) {
+    auto ev = nextEvent(deadline);
+    if (!ev) return ev.error();
+    if (!*ev) {
+      ++counters_.timeouts;
+      return makeError(std::errc::timed_out, "no telegram within " + std::to_string(timeout.count() / 1000) + " ms");
+    }
+    if ((*ev)->kind == StreamEvent::Kind::kTelegram) return std::move((*ev)->telegram);
+  }
+}
+
+}  // namespace fusedet::drivers::lms291

@@ -1,0 +1,145 @@
+#include "fusedet/drivers/lms291/telegram.h"
+
+namespace fusedet::drivers::lms291 {
+
+std::uint16_t crc16(std::span<const std::uint8_t> bytes) {
+  std::uint16_t crc = 0;
+  std::uint8_t prev = 0;
+  for (std::uint8_t b : bytes) {
+    const bool carry = (crc & 0x8000u) != 0;
+    crc = static_cast<std::uint16_t>(crc << 1);
+    if (carry) crc ^= 0x8005u;
+    crc ^= static_cast<std::uint16_t>((prev << 8) | b);
+    prev = b;
+  }
+  return crc;
+}
+
+std::vector<std::uint8_t> encode(const Telegram& t) {
+  const std::size_t length = 1 + t.data.size() + (t.status ? 1 : 0);
+  std::vector<std::uint8_t> out;
+  out.reserve(length + kFrameOverhead);
+  out.push_back(kStx);
+  out.push_back(t.address);
+  out.push_back(static_cast<std::uint8_t>(length & 0xFF));
+  out.push_back(static_cast<std::uint8_t>(length >> 8));
+  out.push_back(t.command);
+  out.insert(out.end(), t.data.begin(), t.data.end());
+  if (t.status) out.push_back(*t.status);
+  const std::uint16_t crc = crc16(out);
+  out.push_back(static_cast<std::uint8_t>(crc & 0xFF));
+  out.push_back(static_cast<std::uint8_t>(crc >> 8));
+  return out;
+}
+
+std::vector<std::uint8_t> encodeRequest(std::uint8_t command, std::span<const std::uint8_t> data) {
+  Telegram t;
+  t.address = kHostAddress;
+  t.command = command;
+  t.data.assign(data.begin(), data.end());
+  return encode(t);
+}
+
+void TelegramReader::feed(std::span<const std::uint8_t> bytes, Stamp received) {
+  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+  counters_.bytes += bytes.size();
+  lastFeed_ = received;
+}
+
+void TelegramReader::clear() {
+  bufferOffset_ += buffer_.size();
+  buffer_.clear();
+  inGarbage_ = false;
+}
+
+void TelegramReader::skip(std::size_t n) {
+  if (!inGarbage_) {
+    ++counters_.resyncs;
+    inGarbage_ = true;
+  }
+  counters_.skippedBytes += n;
+  buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(n));
+  bufferOffset_ += n;
+}
+
+// Header at buffer_[at]: STX, an address of the expected direction, a length that fits.
+bool TelegramReader::plausibleHeader(std::size_t at, std::size_t* frameSize) const {
+  const std::uint8_t address = buffer_[at + 1];
+  const bool device = (address & kReplyAddressBit) != 0;
+  if (direction_ == Direction::kFromDevice && !device) return false;
+  if (direction_ == Direction::kFromHost && address != kHostAddress) return false;
+  const std::size_t length = buffer_[at + 2] | (std::size_t{buffer_[at + 3]} << 8);
+  const std::size_t minLength = device ? 2 : 1;  // CMD (+ STATUS)
+  if (length < minLength || length > kMaxLength) return false;
+  *frameSize = length + kFrameOverhead;
+  return true;
+}
+
+std::optional<StreamEvent> TelegramReader::next() {
+  while (!buffer_.empty()) {
+    const std::uint8_t b = buffer_.front();
+    if (b == kAck || b == kNak) {
+      StreamEvent e;
+      e.kind = b == kAck ? StreamEvent::Kind::kAckByte : StreamEvent::Kind::kNakByte;
+      e.offset = bufferOffset_;
+      e.received = lastFeed_;
+      ++(b == kAck ? counters_.acks : counters_.naks);
+      buffer_.pop_front();
+      ++bufferOffset_;
+      inGarbage_ = false;
+      return e;
+    }
+    if (b != kStx) {
+      skip(1);
+      continue;
+    }
+    if (buffer_.size() < 4) return std::nullopt;  // need the header to judge
+    std::size_t frameSize = 0;
+    if (!plausibleHeader(0, &frameSize)) {
+      skip(1);
+      continue;
+    }
+    if (buffer_.size() < frameSize) return std::nullopt;
+    std::vector<std::uint8_t> raw(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(frameSize));
+    const std::uint16_t sent = static_cast<std::uint16_t>(raw[frameSize - 2] | (raw[frameSize - 1] << 8));
+    const bool ok = crc16(std::span(raw).first(frameSize - 2)) == sent;
+
+    StreamEvent e;
+    e.offset = bufferOffset_;
+    e.received = lastFeed_;
+    Telegram& t = e.telegram;
+    t.address = raw[1];
+    t.command = raw[4];
+    const bool hasStatus = t.fromDevice();
+    const std::size_t dataEnd = frameSize - 2 - (hasStatus ? 1 : 0);
+    t.data.assign(raw.begin() + 5, raw.begin() + static_cast<std::ptrdiff_t>(dataEnd));
+    if (hasStatus) t.status = raw[frameSize - 3];
+    t.received = lastFeed_;
+    t.offset = bufferOffset_;
+    e.raw = std::move(raw);
+    if (ok) {
+      e.kind = StreamEvent::Kind::kTelegram;
+      ++counters_.telegrams;
+      buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(frameSize));
+      bufferOffset_ += frameSize;
+      inGarbage_ = false;
+    } else {
+      // Only the STX goes: a corrupt LEN must not take the next good telegram with it.
+      e.kind = StreamEvent::Kind::kBadCrc;
+      ++counters_.crcErrors;
+      skip(1);
+    }
+    return e;
+  }
+  return std::nullopt;
+}
+
+bool TelegramReader::expirePending() {
+  if (buffer_.empty()) return false;
+  // Whatever is left cannot complete: drop its first byte and let next() rescan the rest.
+  ++counters_.expired;
+  skip(1);
+  return true;
+}
+
+}  // namespace fusedet::drivers::lms291
