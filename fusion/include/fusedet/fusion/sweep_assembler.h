@@ -1,0 +1,85 @@
+#pragma once
+// SweepAssembler: LaserScan + TiltSample streams of a nodding SICK LMS -> 3D sweeps (design §4).
+//
+// Geometry: beam angle a (0 = right, pi/2 = ahead, counter-clockwise) and range r give
+// p_s = r (sin a, -cos a, 0) in the scanner frame (x ahead, y left, z up). The scanner sits on the
+// tilt axis at `tiltAxisOffset` (scanner frame, at tilt 0) and is rotated by the tilt angle about
+// `tiltAxis` (right-hand rule): p_base = Rot(axis, tilt(t_beam)) (p_s + offset), then
+// p = baseToRobot * p_base. With the default axis +y, a positive tilt turns the forward beam down.
+//
+// Time: the tilt angle is interpolated linearly at each beam's own stamp between the two tilt
+// samples around it. A scan whose beams are not all bracketed by samples at most `tiltWindowS`
+// away is dropped and counted - never extrapolated. Sweeps are split where the tilt direction
+// reverses (and after a pause longer than `maxScanGapS`).
+
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "fusedet/drivers/messages.h"
+#include "fusedet/fusion/sweep.h"
+
+namespace fusedet::fusion {
+
+struct SweepConfig {
+  Eigen::Vector3d tiltAxisOffset{0, 0, 0.05};  // [m] scanner origin relative to the tilt axis
+  Eigen::Vector3d tiltAxis{0, 1, 0};           // tilt axis direction in the base frame (normalised)
+  Eigen::Isometry3d baseToRobot = Eigen::Isometry3d::Identity();
+  double tiltWindowS = 0.05;         // max time from a beam to the tilt samples around it
+  double remissionFullScale = 1.0;   // raw remission value that maps to 1 (1 = already normalised)
+  double minRange = 0.05;            // [m] shorter returns are noise (LMS: dazzle, dirt on the window)
+  double maxRange = 80.0;            // [m] longer returns are dropped
+  double maxScanGapS = 1.0;          // a longer pause between scans closes the sweep
+  double minTiltChange = 1e-5;       // [rad] over one scan; below it the direction is undecided
+};
+
+struct SweepStats {
+  std::uint64_t scans = 0;             // scans received
+  std::uint64_t scansUsed = 0;         // scans turned into points
+  std::uint64_t scansDroppedNoTilt = 0;  // no tilt samples within the window around some beam
+  std::uint64_t tiltSamples = 0;
+  std::uint64_t tiltOutOfOrder = 0;    // samples not newer than the last one, ignored
+  std::uint64_t sweeps = 0;            // sweeps completed
+  std::uint64_t points = 0;            // points in completed sweeps
+};
+
+class SweepAssembler {
+ public:
+  explicit SweepAssembler(SweepConfig config = {});
+
+  void addTilt(const drivers::TiltSample& sample);
+  void addScan(const drivers::LaserScan& scan);
+  // Completed sweeps, oldest first; the assembler keeps none of them.
+  std::vector<Sweep> takeSweeps();
+  // End of stream: decides pending scans (dropping those the tilt data never reached) and closes
+  // the open sweep.
+  void flush();
+
+  const SweepStats& stats() const { return stats_; }
+  const SweepConfig& config() const { return config_; }
+
+  // Tilt angle at time t interpolated from the samples around it, or false if there are none
+  // within the window on both sides. Exposed for tests and diagnostics.
+  bool tiltAt(Stamp t, double& angle) const;
+
+ private:
+  void process(bool final);
+  void useScan(const drivers::LaserScan& scan, const std::vector<double>& tilt);
+  void closeSweep();
+
+  SweepConfig config_;
+  std::int64_t windowNs_;
+  std::deque<drivers::TiltSample> tilt_;
+  std::deque<drivers::LaserScan> pending_;
+  Stamp newestScan_{};
+  Sweep open_;
+  bool hasOpen_ = false;
+  int direction_ = 0;  // +1 rising, -1 falling, 0 not yet known
+  Stamp lastBeam_{};
+  std::uint64_t nextId_ = 0;
+  std::vector<Sweep> done_;
+  SweepStats stats_;
+};
+
+}  // namespace fusedet::fusion
