@@ -1,0 +1,105 @@
+#pragma once
+// Training a cascade for one class (paper §2-§4, design.md §5): the library entry point that
+// `fusedet train` and `fusedet experiments` call.
+//
+//   Cascade trainCascade(const TrainingConfig&, const std::vector<DatasetItem>& train,
+//                        ProgressSink&, TrainingReport* = nullptr);
+//
+// Per stage: positives still accepted by the cascade so far; negatives bootstrapped from the
+// label-free windows the cascade still accepts (training_set.h); the feature pool evaluated on
+// all samples once and quantised (feature_matrix.h); Gentle AdaBoost rounds (gentle_boost.h)
+// until the stage's false-alarm rate <= maxFalseAlarm at hit rate >= minHit. Stages are added
+// until the cascade accepts no more than targetFalseAlarm of the label-free windows, the stage
+// limit is reached, or too few negatives (or positives) remain; TrainingReport::stopReason says
+// which, with the numbers. Same config (seed) + same data => identical cascade, for any thread
+// count.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/cascade.h"
+#include "fusedet/boost/feature_pool.h"
+#include "fusedet/boost/gentle_boost.h"
+#include "fusedet/boost/training_set.h"
+#include "fusedet/core/dataset.h"
+
+namespace fusedet::boosting {
+
+struct TrainingConfig {
+  std::string className = "car";
+  PoolConfig pool;        // layers, feature types, grid
+  SampleConfig samples;   // className is taken from above
+  StageConfig stage;      // min_hit, max_fa, rounds per stage
+  double targetFalseAlarm = 1e-5;     // of the label-free windows scanned
+  int maxStages = 20;
+  std::size_t negativesPerStage = 0;  // 0 = max(500, 2 x positives)
+  std::size_t minNegatives = 50;      // fewer still-accepted negatives end training
+  std::size_t minPositives = 10;      // fewer still-accepted positives end training
+  std::uint64_t seed = 1;
+  int threads = 0;                    // 0 = all cores
+
+  // Throws std::invalid_argument naming the bad setting.
+  void validate() const;
+};
+
+struct StageReport {
+  int stage = 0;  // 1-based
+  int weak = 0;   // stumps
+  double hitRate = 0, falseAlarm = 0;  // on this stage's training samples
+  bool reachedFalseAlarm = false;      // false: stopped at the round limit
+  std::size_t positives = 0, negatives = 0;
+  std::size_t windowsScanned = 0;      // bootstrapping scan before this stage
+  std::size_t negativeCandidates = 0;  // label-free windows the cascade accepted then
+  double cascadeFalseAlarm = 1;        // candidates / candidates before stage 1
+  double seconds = 0;
+};
+
+struct TrainingReport {
+  std::size_t poolSize = 0;
+  std::size_t positives = 0;  // incl. mirrored copies
+  int windowWidth = 0, windowHeight = 0;
+  std::optional<double> referenceHue;
+  std::vector<StageReport> stages;
+  double finalFalseAlarm = 1;  // of the label-free windows, after the last stage
+  std::string stopReason;      // e.g. "reached the target false-alarm rate: 8.1e-06 <= 1e-05"
+  double seconds = 0;
+};
+
+enum class ProgressKind { kStart, kStageStart, kNegatives, kRound, kStageDone, kFinished };
+
+struct ProgressEvent {
+  ProgressKind kind = ProgressKind::kStart;
+  int stage = 0, maxStages = 0;  // 1-based stage
+  int round = 0, maxRounds = 0;
+  double hitRate = 0, falseAlarm = 0;        // current stage, on its samples
+  std::size_t positives = 0, negatives = 0;  // samples of the current stage
+  std::size_t windowsScanned = 0;
+  double cascadeFalseAlarm = 1;
+  double elapsedSeconds = 0;
+  std::string message;  // human-readable line for kStart, kStageDone, kFinished
+};
+
+class ProgressSink {
+ public:
+  virtual ~ProgressSink() = default;
+  virtual void onProgress(const ProgressEvent& event) = 0;
+};
+
+class NullProgress : public ProgressSink {
+ public:
+  void onProgress(const ProgressEvent&) override {}
+};
+
+// Trains; throws std::invalid_argument for a bad config and std::runtime_error when the data has
+// no positives of the class or lacks a selected layer (the message names the item).
+Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem>& train,
+                     ProgressSink& progress, TrainingReport* report = nullptr);
+
+// Reference hue of config.className's positives in `items` (reference_hue.h), from their hue
+// layer. Throws std::runtime_error when no positive has hue values.
+double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples);
+
+}  // namespace fusedet::boosting

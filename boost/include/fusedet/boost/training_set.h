@@ -1,0 +1,86 @@
+#pragma once
+// Training samples (paper §4): positives from the labelled boxes of one class (optionally also
+// from horizontally flipped copies of their stacks), negatives bootstrapped for every new stage
+// from windows of the training stacks that no label of the class overlaps (IoU < 0.3; windows
+// lying in ignore regions such as KITTI DontCare are skipped) and from clutter stacks (stacks
+// without the class), keeping only windows the current cascade still accepts.
+//
+// Samples are windows on integral stacks held here; features are evaluated on the stack itself,
+// exactly as the detector does (feature.h's pixel rule), so training sees what detection sees.
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/cascade.h"
+#include "fusedet/boost/detector.h"
+#include "fusedet/boost/integral_stack.h"
+#include "fusedet/core/dataset.h"
+
+namespace fusedet::boosting {
+
+struct SampleConfig {
+  std::string className = "car";
+  // Labels of the class that become positives (KITTI "moderate" by default).
+  double minPositiveHeight = 25;  // reference pixels
+  int maxOcclusion = 1;
+  bool flipPositives = true;
+  // A window is a negative candidate when IoU < maxNegativeIou with every label of the class
+  // (positive or not) and it lies in no ignore region by more than maxIgnoreCoverage of its area.
+  double maxNegativeIou = 0.3;
+  double maxIgnoreCoverage = 0.5;
+  int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
+  ScanParams scan;            // windows scanned for negatives (scales, step)
+};
+
+struct Sample {
+  std::uint32_t stack = 0;  // index into TrainingStacks
+  Box window;               // reference pixels of that stack
+};
+
+// Does `label` become a positive of `config.className`?
+bool isPositiveLabel(const Label& label, const SampleConfig& config);
+// May `window` of a stack with `labels` serve as a negative?
+bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& config);
+
+struct NegativeHarvest {
+  std::vector<Sample> samples;
+  std::size_t windowsScanned = 0;   // all windows the scan visited
+  std::size_t candidates = 0;       // of those: label-free windows the cascade accepts
+};
+
+class TrainingStacks {
+ public:
+  // Integrates `layers` of every item (hue_distance derived with referenceHue); stacks holding
+  // positives get a mirrored copy when config.flipPositives. Throws when an item lacks a layer.
+  TrainingStacks(const std::vector<DatasetItem>& items, const std::vector<std::string>& layers,
+                 std::optional<double> referenceHue, const SampleConfig& config);
+
+  std::size_t size() const { return integrals_.size(); }
+  const IntegralStack& integrals(std::size_t i) const { return integrals_.at(i); }
+  const std::vector<Sample>& positives() const { return positives_; }
+  const SampleConfig& config() const { return config_; }
+  std::size_t originalStacks() const { return originals_; }  // [0, originals) are the items
+
+  // Median width / height of the positives (reference pixels); 1 when there are none.
+  double positiveAspect() const;
+
+  // Up to `wanted` negatives, sampled uniformly (reservoir, seeded) from the label-free windows of
+  // the original stacks that `cascade` accepts (every window when cascade has no stages).
+  NegativeHarvest harvestNegatives(const Cascade& cascade, std::size_t wanted, std::uint64_t seed,
+                                   int threads) const;
+
+ private:
+  std::vector<IntegralStack> integrals_;
+  std::vector<Labels> labels_;  // per stack (mirrored for flipped copies)
+  std::vector<Sample> positives_;
+  std::size_t originals_ = 0;
+  SampleConfig config_;
+};
+
+// Horizontally mirrored copy of a stack (every layer and mask) and its labels.
+DatasetItem flipItem(const DatasetItem& item);
+
+}  // namespace fusedet::boosting

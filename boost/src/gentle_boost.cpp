@@ -1,0 +1,68 @@
+#include "fusedet/boost/gentle_boost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace fusedet::boosting {
+
+double stageThreshold(std::vector<double> scores, double minHit) {
+  if (scores.empty()) return 0;
+  std::sort(scores.begin(), scores.end());
+  const auto n = static_cast<double>(scores.size());
+  // May drop at most floor((1 - minHit) * n) positives (with a tolerance for 0.995 * 200 etc.).
+  const auto drop = static_cast<std::size_t>(std::floor((1.0 - minHit) * n + 1e-9));
+  const double t = scores[std::min(drop, scores.size() - 1)];
+  return t - 1e-9 * std::max(1.0, std::fabs(t));
+}
+
+StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
+                       const FeatureValuesFn& rawValues, const StageConfig& config,
+                       const std::function<void(const RoundInfo&)>& onRound) {
+  const std::size_t n = m.samples();
+  if (positives == 0 || positives >= n)
+    throw std::invalid_argument("trainStage: need positives and negatives (" +
+                                std::to_string(positives) + " of " + std::to_string(n) + " samples)");
+  // Each class starts with half the weight, so the first stump is not dominated by the larger set.
+  std::vector<double> w(n);
+  for (std::size_t i = 0; i < n; ++i)
+    w[i] = i < positives ? 0.5 / double(positives) : 0.5 / double(n - positives);
+  std::vector<float> wf(n);
+  std::vector<double> score(n, 0.0);
+  std::vector<float> values(n);
+  StumpSearchOptions search;
+  search.threads = config.threads;
+  search.refineTop = config.refineTop;
+  StageResult result;
+  for (int round = 1; round <= config.maxWeak; ++round) {
+    for (std::size_t i = 0; i < n; ++i) wf[i] = static_cast<float>(w[i]);
+    const FittedStump s = findBestStump(m, positives, wf, rawValues, search);
+    rawValues(s.feature, values);
+    double sum = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double f = s(values[i]);
+      score[i] += f;
+      const double y = i < positives ? 1.0 : -1.0;
+      w[i] *= std::exp(-y * f);
+      sum += w[i];
+    }
+    for (double& v : w) v /= sum;
+    result.stumps.push_back(s);
+    result.threshold =
+        stageThreshold(std::vector<double>(score.begin(), score.begin() + static_cast<std::ptrdiff_t>(positives)),
+                       config.minHit);
+    std::size_t hits = 0, fas = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (score[i] >= result.threshold) (i < positives ? hits : fas)++;
+    result.hitRate = double(hits) / double(positives);
+    result.falseAlarm = double(fas) / double(n - positives);
+    if (onRound) onRound(RoundInfo{round, result.hitRate, result.falseAlarm, result.threshold, s});
+    if (result.falseAlarm <= config.maxFalseAlarm) {
+      result.reachedFalseAlarm = true;
+      break;
+    }
+  }
+  return result;
+}
+
+}  // namespace fusedet::boosting

@@ -1,0 +1,201 @@
+#include "fusedet/boost/stump.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace fusedet::boosting {
+
+namespace {
+
+constexpr int kBins = FeatureMatrix::kMaxBins;
+constexpr int kLanes = 4;  // independent sub-histograms: repeated bins do not serialise the adds
+
+// Total order of candidates: larger gain first, then smaller feature, then smaller bin.
+bool better(const SplitCandidate& a, const SplitCandidate& b) {
+  if (a.gain != b.gain) return a.gain > b.gain;
+  if (a.feature != b.feature) return a.feature < b.feature;
+  return a.bin < b.bin;
+}
+
+void keepTop(std::vector<SplitCandidate>& top, const SplitCandidate& c, std::size_t k) {
+  if (top.size() == k && !better(c, top.back())) return;
+  top.insert(std::upper_bound(top.begin(), top.end(), c, better), c);
+  if (top.size() > k) top.pop_back();
+}
+
+// Adds weights[i] into hist[lane][bins[i]] for i in [begin, end).
+inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t begin, std::size_t end,
+                       float (*hist)[kBins]) {
+  std::size_t i = begin;
+  for (; i + kLanes <= end; i += kLanes) {
+    hist[0][bins[i]] += w[i];
+    hist[1][bins[i + 1]] += w[i + 1];
+    hist[2][bins[i + 2]] += w[i + 2];
+    hist[3][bins[i + 3]] += w[i + 3];
+  }
+  for (; i < end; ++i) hist[0][bins[i]] += w[i];
+}
+
+// Best split of one feature's histogram (pos/neg weight per bin), or gain -1 if none.
+SplitCandidate scanBins(std::size_t feature, const float (*pos)[kBins], const float (*neg)[kBins]) {
+  std::array<double, kBins> wp{}, wn{};
+  double totP = 0, totN = 0;
+  int last = -1;  // highest non-empty bin
+  for (int b = 0; b < kBins; ++b) {
+    wp[b] = double(pos[0][b]) + pos[1][b] + pos[2][b] + pos[3][b];
+    wn[b] = double(neg[0][b]) + neg[1][b] + neg[2][b] + neg[3][b];
+    totP += wp[b];
+    totN += wn[b];
+    if (wp[b] + wn[b] > 0) last = b;
+  }
+  SplitCandidate best{feature, 0, -1};
+  double lp = 0, ln = 0;
+  const double tot = totP + totN, totS = totP - totN;
+  for (int b = 0; b < last; ++b) {
+    lp += wp[b];
+    ln += wn[b];
+    const double wl = lp + ln, wr = tot - wl;
+    if (wl <= 0 || wr <= 0) continue;
+    const double sl = lp - ln, sr = totS - sl;
+    const double gain = sl * sl / wl + sr * sr / wr;
+    if (gain > best.gain) best = {feature, b, gain};
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t positives,
+                                             std::span<const float> weights, std::size_t k,
+                                             int threads) {
+  const std::size_t n = m.samples();
+  if (weights.size() != n || positives > n)
+    throw std::invalid_argument("bestBinnedSplits: " + std::to_string(weights.size()) +
+                                " weights / " + std::to_string(positives) + " positives for " +
+                                std::to_string(n) + " samples");
+  k = std::max<std::size_t>(1, k);
+  constexpr std::size_t kChunk = 256;
+  const std::size_t chunks = (m.features() + kChunk - 1) / kChunk;
+  std::vector<std::vector<SplitCandidate>> perChunk(chunks);
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                        alignas(64) float pos[kLanes][kBins];
+                        alignas(64) float neg[kLanes][kBins];
+                        for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                          std::vector<SplitCandidate> top;
+                          const std::size_t end = std::min(m.features(), (c + 1) * kChunk);
+                          for (std::size_t f = c * kChunk; f < end; ++f) {
+                            std::memset(pos, 0, sizeof pos);
+                            std::memset(neg, 0, sizeof neg);
+                            const std::uint8_t* bins = m.row(f);
+                            accumulate(bins, weights.data(), 0, positives, pos);
+                            accumulate(bins, weights.data(), positives, n, neg);
+                            const SplitCandidate s = scanBins(f, pos, neg);
+                            if (s.gain >= 0) keepTop(top, s, k);
+                          }
+                          perChunk[c] = std::move(top);
+                        }
+                      });
+  });
+  std::vector<SplitCandidate> top;
+  for (const auto& chunk : perChunk)
+    for (const SplitCandidate& s : chunk) keepTop(top, s, k);
+  return top;
+}
+
+FittedStump fitStumpExact(std::size_t feature, std::span<const float> values,
+                          std::span<const float> weights, std::size_t positives) {
+  const std::size_t n = values.size();
+  if (weights.size() != n || positives > n)
+    throw std::invalid_argument("fitStumpExact: sizes of values, weights and positives differ");
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  // NaN sorts last (and goes right: NaN < threshold is false).
+  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const float va = values[a], vb = values[b];
+    if (std::isnan(vb)) return !std::isnan(va);
+    return va < vb;
+  });
+  double tot = 0, totS = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    tot += weights[i];
+    totS += i < positives ? weights[i] : -double(weights[i]);
+  }
+  FittedStump best;
+  best.feature = feature;
+  const double mean = tot > 0 ? totS / tot : 0;
+  best.left = best.right = mean;  // no split: constant stump
+  double bestGain = tot > 0 ? totS * totS / tot : 0;
+  double wl = 0, sl = 0;
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    const std::uint32_t i = order[k];
+    wl += weights[i];
+    sl += i < positives ? weights[i] : -double(weights[i]);
+    const float a = values[i], b = values[order[k + 1]];
+    if (!(b > a)) continue;  // equal values (or NaN) cannot be separated
+    const double wr = tot - wl, sr = totS - sl;
+    if (wl <= 0 || wr <= 0) continue;
+    const double gain = sl * sl / wl + sr * sr / wr;
+    if (gain > bestGain) {
+      bestGain = gain;
+      float t = static_cast<float>((double(a) + double(b)) / 2);
+      if (!(t > a)) t = b;  // adjacent floats: the midpoint rounds onto a
+      best.threshold = t;
+      best.left = sl / wl;
+      best.right = sr / wr;
+    }
+  }
+  best.error = std::max(0.0, tot - bestGain);
+  return best;
+}
+
+double stumpSquaredError(const FittedStump& s, std::span<const float> values,
+                         std::span<const float> weights, std::size_t positives) {
+  double e = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double y = i < positives ? 1.0 : -1.0;
+    const double d = y - s(values[i]);
+    e += weights[i] * d * d;
+  }
+  return e;
+}
+
+FittedStump findBestStump(const FeatureMatrix& m, std::size_t positives,
+                          std::span<const float> weights, const FeatureValuesFn& rawValues,
+                          const StumpSearchOptions& options) {
+  if (m.features() == 0 || m.samples() == 0)
+    throw std::invalid_argument("findBestStump: empty feature matrix");
+  const auto candidates =
+      bestBinnedSplits(m, positives, weights, options.refineTop, options.threads);
+  std::vector<float> values(m.samples());
+  FittedStump best;
+  bool have = false;
+  // Candidates come in feature order among equal gains; refine in ascending feature order so the
+  // exact tie-break (smaller feature wins) does not depend on the binned ranking.
+  std::vector<std::size_t> features;
+  for (const auto& c : candidates) features.push_back(c.feature);
+  if (features.empty()) features.push_back(0);
+  std::sort(features.begin(), features.end());
+  for (std::size_t f : features) {
+    rawValues(f, values);
+    const FittedStump s = fitStumpExact(f, values, weights, positives);
+    if (!have || s.error < best.error) {
+      best = s;
+      have = true;
+    }
+  }
+  return best;
+}
+
+}  // namespace fusedet::boosting

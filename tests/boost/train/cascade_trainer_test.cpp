@@ -1,0 +1,209 @@
+#include "fusedet/boost/cascade_trainer.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+#include <random>
+
+#include "fusedet/boost/detector.h"
+#include "fusedet/boost/model_io.h"
+
+using namespace fusedet;
+using namespace fusedet::boosting;
+
+namespace {
+
+// Synthetic scenes: noisy background, "cars" = 36x24 boxes with a bright upper half and a dark
+// lower half (hue 200 inside, 40 outside), "vans" = uniformly bright boxes (a hard negative),
+// a DontCare region in some scenes.
+DatasetItem scene(unsigned seed, int cars, bool withHue) {
+  std::mt19937 rng(seed);
+  cv::Mat img(120, 200, CV_8U);
+  cv::randu(img, 60, 140);
+  cv::Mat hue(120, 200, CV_32F, cv::Scalar(40.f));
+  DatasetItem item;
+  item.id = "synthetic/" + std::to_string(seed);
+  item.group = "synthetic";
+  std::uniform_int_distribution<int> x(0, 200 - 40), y(0, 120 - 28);
+  std::vector<cv::Rect> placed;
+  auto free = [&](const cv::Rect& r) {
+    for (const auto& p : placed)
+      if ((r & p).area() > 0) return false;
+    return true;
+  };
+  for (int k = 0, tries = 0; k < cars + 1 && tries < 100; ++tries) {
+    const int w = 34 + int(rng() % 5), h = 24;
+    cv::Rect r(x(rng), y(rng), w, h);
+    if (!free(r)) continue;
+    placed.push_back(r);
+    Label l;
+    l.box = Box{double(r.x), double(r.y), double(r.width), double(r.height)};
+    if (k < cars) {
+      img(cv::Rect(r.x, r.y, r.width, r.height / 2)) += cv::Scalar(70);
+      img(cv::Rect(r.x, r.y + r.height / 2, r.width, r.height / 2)) -= cv::Scalar(50);
+      hue(r).setTo(200.f);
+      l.className = "car";
+      l.sourceClass = "Car";
+    } else {
+      img(r) += cv::Scalar(60);
+      l.className = "van";
+      l.sourceClass = "Van";
+    }
+    item.labels.push_back(l);
+    ++k;
+  }
+  if (seed % 3 == 0) {
+    Label dc;
+    dc.box = Box{0, 0, 30, 30};
+    dc.ignore = true;
+    dc.sourceClass = "DontCare";
+    item.labels.push_back(dc);
+  }
+  item.stack = LayerStack(200, 120);
+  item.stack.set(Layer{"intensity", img, {}});
+  if (withHue) item.stack.set(Layer{"hue", hue, {}});
+  return item;
+}
+
+TrainingConfig smallConfig() {
+  TrainingConfig c;
+  c.className = "car";
+  c.pool.grid = 6;
+  c.pool.layers = {"intensity"};
+  c.samples.baseWindowHeight = 12;
+  c.samples.minPositiveHeight = 20;
+  c.samples.scan.scaleFactor = 1.25;
+  c.samples.scan.step = 2;
+  c.maxStages = 3;
+  c.negativesPerStage = 300;
+  c.stage.maxWeak = 20;
+  c.seed = 5;
+  return c;
+}
+
+std::vector<DatasetItem> scenes(int n, bool withHue) {
+  std::vector<DatasetItem> items;
+  for (int i = 0; i < n; ++i) items.push_back(scene(100 + unsigned(i), i % 4 == 3 ? 0 : 2, withHue));
+  return items;
+}
+
+class Recorder : public ProgressSink {
+ public:
+  void onProgress(const ProgressEvent& e) override { events.push_back(e); }
+  std::vector<ProgressEvent> events;
+};
+
+}  // namespace
+
+TEST(CascadeTrainer, LearnsSyntheticCarsAndReportsItsStop) {
+  const auto items = scenes(12, false);
+  Recorder rec;
+  TrainingReport report;
+  const Cascade c = trainCascade(smallConfig(), items, rec, &report);
+  EXPECT_EQ(c.className, "car");
+  EXPECT_GE(c.stages.size(), 1u);
+  EXPECT_LE(c.stages.size(), 3u);
+  EXPECT_EQ(report.stages.size(), c.stages.size());
+  EXPECT_FALSE(report.stopReason.empty());
+  EXPECT_EQ(report.poolSize, poolSize(smallConfig().pool));
+  EXPECT_NEAR(double(c.windowWidth) / c.windowHeight, 36.0 / 24, 0.15);
+  // 18 cars (3 of 4 scenes hold 2) and their mirrored copies.
+  EXPECT_EQ(report.positives, 36u);
+  for (const StageReport& s : report.stages) {
+    EXPECT_GE(s.hitRate, 0.995);
+    if (s.reachedFalseAlarm) {
+      EXPECT_LE(s.falseAlarm, 0.5);
+    }
+  }
+  EXPECT_EQ(rec.events.front().kind, ProgressKind::kStart);
+  EXPECT_EQ(rec.events.back().kind, ProgressKind::kFinished);
+
+  // On unseen scenes: every car found at IoU >= 0.5 among the raw hits, few windows accepted.
+  const Detector det(c);
+  ScanParams p;
+  p.scaleFactor = 1.1;
+  p.step = 1;
+  std::size_t found = 0, cars = 0, hits = 0, windows = 0;
+  for (unsigned s = 900; s < 906; ++s) {
+    const DatasetItem t = scene(s, 2, false);
+    ScanStats stats;
+    const auto raw = det.scan(t.stack, p, &stats);
+    windows += stats.windows;
+    hits += raw.size();
+    for (const Label& l : t.labels) {
+      if (l.className != "car") continue;
+      ++cars;
+      for (const RawHit& h : raw)
+        if (iou(h.box, l.box) >= 0.5) {
+          ++found;
+          break;
+        }
+    }
+  }
+  EXPECT_GE(double(found), 0.8 * double(cars)) << found << " of " << cars << "; " << report.stopReason;
+  EXPECT_LT(double(hits) / double(windows), 0.05);
+}
+
+TEST(CascadeTrainer, SameSeedSameDataGivesByteIdenticalModelForAnyThreadCount) {
+  const auto items = scenes(8, true);
+  TrainingConfig c = smallConfig();
+  c.pool.layers = {"intensity", "hue_distance"};
+  c.maxStages = 2;
+  c.threads = 1;
+  NullProgress quiet;
+  const std::string one = modelToText(trainCascade(c, items, quiet), {{"seed", "5"}});
+  c.threads = 2;
+  const Cascade second = trainCascade(c, items, quiet);
+  EXPECT_EQ(modelToText(second, {{"seed", "5"}}), one);
+  ASSERT_TRUE(second.referenceHue.has_value());
+  EXPECT_DOUBLE_EQ(*second.referenceHue, 205.0);  // the cars' hue, 200, lies in bin 200-210
+  c.seed = 6;
+  EXPECT_NE(modelToText(trainCascade(c, items, quiet), {{"seed", "5"}}), one);
+}
+
+TEST(CascadeTrainer, ClearErrorsForNoPositivesAndMissingLayers) {
+  auto items = scenes(4, false);
+  TrainingConfig c = smallConfig();
+  c.className = "person";
+  NullProgress quiet;
+  try {
+    trainCascade(c, items, quiet);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no positives of class 'person'"), std::string::npos) << e.what();
+  }
+  c.className = "car";
+  c.pool.layers = {"distance"};
+  try {
+    trainCascade(c, items, quiet);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("training item synthetic/100"), std::string::npos) << e.what();
+  }
+  c.pool.layers = {"intensity"};
+  c.stage.minHit = 1.5;
+  EXPECT_THROW(trainCascade(c, items, quiet), std::invalid_argument);
+}
+
+TEST(CascadeTrainer, NegativeWindowsAvoidLabelsAndIgnoreRegions) {
+  SampleConfig s;
+  Labels labels(3);
+  labels[0].className = "car";
+  labels[0].box = Box{100, 100, 40, 20};
+  labels[1].className = "van";
+  labels[1].box = Box{0, 0, 40, 20};
+  labels[2].ignore = true;
+  labels[2].box = Box{200, 0, 50, 50};
+  EXPECT_FALSE(isNegativeWindow(Box{105, 100, 40, 20}, labels, s));  // IoU 0.78 with the car
+  EXPECT_TRUE(isNegativeWindow(Box{130, 100, 40, 20}, labels, s));   // IoU 0.14
+  EXPECT_TRUE(isNegativeWindow(Box{0, 0, 40, 20}, labels, s));       // on the van: hard negative
+  EXPECT_FALSE(isNegativeWindow(Box{210, 10, 20, 20}, labels, s));   // inside DontCare
+  Label small;
+  small.className = "car";
+  small.box = Box{0, 0, 30, 20};
+  EXPECT_FALSE(isPositiveLabel(small, s));  // below 25 px
+  small.box.h = 30;
+  EXPECT_TRUE(isPositiveLabel(small, s));
+  small.occlusion = 2;
+  EXPECT_FALSE(isPositiveLabel(small, s));
+}

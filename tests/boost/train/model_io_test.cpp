@@ -1,0 +1,135 @@
+#include "fusedet/boost/model_io.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace fusedet;
+using namespace fusedet::boosting;
+
+namespace {
+
+Cascade sample() {
+  Cascade c;
+  c.className = "car";
+  c.windowWidth = 40;
+  c.windowHeight = 24;
+  c.layers = {"intensity", "hue_distance"};
+  c.referenceHue = 25;
+  const int a = c.addFeature(Feature{FeatureType::kCornerTopLeft, Box{0.25, 0, 0.5, 0.5}, 1});
+  const int b = c.addFeature(Feature{FeatureType::kEdgeHorizontal, Box{0, 0.1, 1.0 / 3, 0.7}, 0});
+  c.stages.push_back(Stage{{Stump{a, 0.125, -0.8, 0.5}, Stump{b, -3.5, 0.25, -0.75}}, -0.41});
+  c.stages.push_back(Stage{{Stump{b, 1e-7, -1, 1}}, 0.1});
+  return c;
+}
+
+std::string errorOf(const std::string& text) {
+  try {
+    modelFromText(text, "m.json");
+  } catch (const ModelError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto p = s.find(from);
+  EXPECT_NE(p, std::string::npos) << from;
+  if (p != std::string::npos) s.replace(p, from.size(), to);
+  return s;
+}
+
+}  // namespace
+
+TEST(ModelIo, RoundTripIsExactAndTextIsStable) {
+  const Cascade c = sample();
+  const std::string text = modelToText(c, {{"seed", "1"}});
+  const Cascade back = modelFromText(text, "m.json");
+  EXPECT_EQ(back.className, "car");
+  EXPECT_EQ(back.windowWidth, 40);
+  EXPECT_EQ(back.layers, c.layers);
+  EXPECT_EQ(*back.referenceHue, 25);
+  ASSERT_EQ(back.stages.size(), 2u);
+  EXPECT_EQ(back.stages[0].threshold, -0.41);
+  const Stump& s = back.stages[0].stumps[1];
+  EXPECT_EQ(back.features[size_t(s.feature)], c.features[1]);
+  EXPECT_EQ(s.threshold, -3.5);
+  EXPECT_EQ(back.stages[1].stumps[0].threshold, 1e-7);
+  // Shared features stay shared.
+  EXPECT_EQ(back.stages[1].stumps[0].feature, s.feature);
+  EXPECT_EQ(modelToText(back, {{"seed", "1"}}), text);
+  EXPECT_NE(text.find("\"version\": 1"), std::string::npos);
+  EXPECT_NE(text.find("\"type\":\"g\""), std::string::npos);
+}
+
+TEST(ModelIo, SaveAndLoadFile) {
+  const auto dir = std::filesystem::temp_directory_path() / "fusedet_model_io_test";
+  std::filesystem::create_directories(dir);
+  const auto file = dir / "car.json";
+  saveModel(sample(), file);
+  const Cascade c = loadModel(file);
+  EXPECT_EQ(c.source, file.string());
+  EXPECT_EQ(c.weakCount(), 3u);
+  try {
+    loadModel(dir / "missing.json");
+    FAIL();
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing.json: cannot open (no such file)"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ModelIo, ErrorsNameThePlaceAndTheReason) {
+  const std::string good = modelToText(sample());
+  EXPECT_EQ(errorOf(good), "");
+  EXPECT_NE(errorOf(good.substr(0, good.size() / 2)).find("m.json: line "), std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"threshold\":0.125", "\"threshold\":\"x\""))
+                .find("m.json: stages[0].stumps[0].threshold: expected a number, got string"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"type\":\"g\"", "\"type\":\"k\""))
+                .find("stages[0].stumps[0].type: unknown feature type 'k'"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"version\": 1", "\"version\": 7")).find("version: unsupported version 7"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"layer\":\"hue_distance\"", "\"layer\":\"sonar\""))
+                .find("stages[0].stumps[0].layer: layer 'sonar' is not in \"layers\""),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "[0.25,0.0,0.5,0.5]", "[0.75,0.0,0.5,0.5]")).find("stages[0].stumps[0]: "),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"reference_hue\": 25.0", "\"reference_hue\": null")).find("reference hue"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"fusedet-cascade\"", "\"opencv\"")).find("format: 'opencv' is not"),
+            std::string::npos);
+  EXPECT_NE(errorOf("[1,2]").find("expected a JSON object"), std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"threshold\":0.125", "\"threshold\":1e999")).find("m.json: not a valid model"),
+            std::string::npos);
+}
+
+TEST(ModelIo, FuzzedFilesNeverCrash) {
+  const std::string good = modelToText(sample());
+  std::mt19937 rng(11);
+  int loaded = 0, rejected = 0;
+  for (int it = 0; it < 3000; ++it) {
+    std::string s = good;
+    const int edits = 1 + int(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t p = rng() % s.size();
+      switch (rng() % 4) {
+        case 0: s[p] = char(rng() % 256); break;
+        case 1: s.erase(p, 1 + rng() % 8); break;
+        case 2: s = s.substr(0, p) + "{}[],:\"0-e9."[rng() % 12] + s.substr(p); break;
+        default: s.resize(p); break;
+      }
+      if (s.empty()) s.push_back('x');
+    }
+    try {
+      modelFromText(s, "fuzz.json");
+      ++loaded;
+    } catch (const ModelError&) {
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+  EXPECT_EQ(loaded + rejected, 3000);
+}
