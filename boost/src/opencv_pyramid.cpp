@@ -1,18 +1,28 @@
 #include "opencv_pyramid.h"
 
+#include "fusedet/boost/opencv_cascade.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <climits>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#endif
+
 namespace fusedet::boosting {
 
 namespace {
+
+constexpr std::size_t kReadPad = 64;
 
 // cvRound: nearest, ties to even (lrint in the default rounding mode).
 inline int cvRoundF(float v) { return static_cast<int>(std::lrintf(v)); }
@@ -87,19 +97,24 @@ inline int rectSum(const std::int32_t* p, const std::array<std::int32_t, 4>& o) 
                           static_cast<std::uint32_t>(p[o[2]]) + static_cast<std::uint32_t>(p[o[3]]));
 }
 
-// OpenCV's runAt: -1 = window not evaluated (flat), -k = rejected by stage k (0 = first), 1 = accepted.
-inline int runAt(const CvModel& m, const std::int32_t* p, const std::uint32_t* q, double& score,
-                 std::size_t& stumps) {
+// OpenCV's setWindow: the variance normalisation factor, or false for a flat window (standard
+// deviation over the inner area at most 10 grey levels, or zero).
+inline bool normFactor(const CvModel& m, const std::int32_t* p, const std::uint32_t* q, float& vnf) {
   const int valsum = rectSum(p, m.norm);
   const std::uint32_t valsqsum = q[m.norm[0]] - q[m.norm[1]] - q[m.norm[2]] + q[m.norm[3]];
   double nf = m.normArea * double(valsqsum) - double(valsum) * double(valsum);
-  if (!(nf > 0.)) return -1;
+  if (!(nf > 0.)) return false;
   nf = std::sqrt(nf);
-  const auto vnf = static_cast<float>(1. / nf);
-  if (!(m.normArea * vnf < 1e-1)) return -1;
+  vnf = static_cast<float>(1. / nf);
+  return m.normArea * vnf < 1e-1;
+}
+
+// Stages [first, end) of one window: -k = rejected by stage k, 1 = accepted (score = last sum).
+inline int runFrom(const CvModel& m, const std::int32_t* p, float vnf, int first, double& score,
+                   std::size_t& stumps) {
   const CvStump* z = m.stumps.data();
   const int nStages = static_cast<int>(m.stages.size());
-  for (int s = 0; s < nStages; ++s) {
+  for (int s = first; s < nStages; ++s) {
     const CvStage& st = m.stages[static_cast<std::size_t>(s)];
     double sum = 0;
     for (std::uint32_t k = st.begin; k < st.end; ++k) {
@@ -117,6 +132,194 @@ inline int runAt(const CvModel& m, const std::int32_t* p, const std::uint32_t* q
   return 1;
 }
 
+// OpenCV's runAt: -1 = flat window (not classified), -k = rejected by stage k, 1 = accepted.
+inline int runAt(const CvModel& m, const std::int32_t* p, const std::uint32_t* q, double& score,
+                 std::size_t& stumps) {
+  float vnf = 1.f;
+  if (!normFactor(m, p, q, vnf)) return -1;
+  return runFrom(m, p, vnf, 0, score, stumps);
+}
+
+// One row of windows of one scale, given as the first window's pointers.
+struct RowJob {
+  const CvModel* m = nullptr;
+  const std::int32_t* sum = nullptr;   // sum (and tilted) at the row's first window
+  const std::uint32_t* sq = nullptr;   // squared sum at the row's first window
+  int positions = 0;                   // windows in the row (x = 0, step, 2 step, ...)
+  int step = 2;
+};
+
+struct RowResult {
+  std::vector<std::pair<int, double>> hits;  // (position index, score)
+  std::size_t windows = 0, stumps = 0;
+};
+
+// Reference path: OpenCV's loop verbatim, one window at a time.
+void scanRowScalar(const RowJob& j, RowResult& out) {
+  for (int i = 0; i < j.positions; ++i) {
+    const std::ptrdiff_t o = std::ptrdiff_t(i) * j.step;
+    double score = 0;
+    ++out.windows;
+    const int r = runAt(*j.m, j.sum + o, j.sq + o, score, out.stumps);
+    if (r > 0) out.hits.emplace_back(i, score);
+    if (r == 0) ++i;  // OpenCV skips the next position after a first-stage rejection
+  }
+}
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#define FUSEDET_HAVE_AVX2_PATH 1
+
+// Eight windows at once (positions i0 .. i0 + 7 of a row): vector loads of eight integral values
+// at stride `kStep`, the same float and double operations per lane as runFrom(), lane by lane
+// IEEE-identical (separate multiply and add, no FMA). OpenCV's skip rule is applied afterwards on
+// the per-lane first-stage results, so the windows reported are exactly OpenCV's.
+template <int kStep>
+__attribute__((target("avx2"))) inline __m256i load8(const std::int32_t* p) {
+  if constexpr (kStep == 1) {
+    return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p));
+  } else {
+    const __m256i even = _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7);
+    const __m256i a = _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)), even);
+    const __m256i b = _mm256_permutevar8x32_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p + 8)), even);
+    return _mm256_permute2x128_si256(a, b, 0x20);
+  }
+}
+
+template <int kStep>
+__attribute__((target("avx2"))) inline __m256i rectSum8(const std::int32_t* p, const std::array<std::int32_t, 4>& o) {
+  return _mm256_sub_epi32(_mm256_sub_epi32(_mm256_add_epi32(load8<kStep>(p + o[0]), load8<kStep>(p + o[3])),
+                                           load8<kStep>(p + o[1])),
+                          load8<kStep>(p + o[2]));
+}
+
+// Sums of one stage for eight windows (lanes 0-3 in lo, 4-7 in hi).
+template <int kStep>
+__attribute__((target("avx2"))) inline void stage8(const CvModel& m, const CvStage& st, const std::int32_t* p,
+                                                   __m256 vnf, __m256d& lo, __m256d& hi) {
+  lo = _mm256_setzero_pd();
+  hi = _mm256_setzero_pd();
+  for (std::uint32_t k = st.begin; k < st.end; ++k) {
+    const CvStump& t = m.stumps[k];
+    __m256 v = _mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(t.weight[0]), _mm256_cvtepi32_ps(rectSum8<kStep>(p, t.ofs[0]))),
+                             _mm256_mul_ps(_mm256_set1_ps(t.weight[1]), _mm256_cvtepi32_ps(rectSum8<kStep>(p, t.ofs[1]))));
+    if (t.count == 3)
+      v = _mm256_add_ps(v, _mm256_mul_ps(_mm256_set1_ps(t.weight[2]), _mm256_cvtepi32_ps(rectSum8<kStep>(p, t.ofs[2]))));
+    v = _mm256_mul_ps(v, vnf);
+    const __m256 lt = _mm256_cmp_ps(v, _mm256_set1_ps(t.threshold), _CMP_LT_OQ);
+    const __m256 leaf = _mm256_blendv_ps(_mm256_set1_ps(t.right), _mm256_set1_ps(t.left), lt);
+    lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(leaf)));
+    hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps(leaf, 1)));
+  }
+}
+
+// setWindow for four windows: normalisation factors and the "not flat" mask.
+__attribute__((target("avx2"))) inline __m128 norm4(__m128i s, __m128i q, __m256d area, int& okMask) {
+  const __m256d sd = _mm256_cvtepi32_pd(s);
+  const __m256d qd = _mm256_add_pd(_mm256_cvtepi32_pd(_mm_xor_si128(q, _mm_set1_epi32(INT32_MIN))),
+                                   _mm256_set1_pd(2147483648.0));  // uint32 -> double, exact
+  const __m256d nf = _mm256_sub_pd(_mm256_mul_pd(area, qd), _mm256_mul_pd(sd, sd));
+  const __m256d positive = _mm256_cmp_pd(nf, _mm256_setzero_pd(), _CMP_GT_OQ);
+  const __m128 vnf = _mm256_cvtpd_ps(_mm256_div_pd(_mm256_set1_pd(1.0), _mm256_sqrt_pd(nf)));
+  const __m256d busy = _mm256_cmp_pd(_mm256_mul_pd(area, _mm256_cvtps_pd(vnf)), _mm256_set1_pd(1e-1), _CMP_LT_OQ);
+  okMask = _mm256_movemask_pd(_mm256_and_pd(positive, busy));
+  return vnf;
+}
+
+template <int kStep>
+__attribute__((target("avx2"))) void scanRowAvx2(const RowJob& j, RowResult& out) {
+  const CvModel& m = *j.m;
+  const int nStages = static_cast<int>(m.stages.size());
+  const __m256d area = _mm256_set1_pd(m.normArea);
+  const auto* sq = reinterpret_cast<const std::int32_t*>(j.sq);
+  bool skipNext = false;  // the previous evaluated window failed the first stage
+  alignas(32) float vnf[8];
+  alignas(32) double sums[8];
+  for (int i0 = 0; i0 < j.positions; i0 += 8) {
+    const int lanes = std::min(8, j.positions - i0);
+    const std::int32_t* p = j.sum + std::ptrdiff_t(i0) * kStep;
+    const std::int32_t* q = sq + std::ptrdiff_t(i0) * kStep;
+    const __m256i s8 = rectSum8<kStep>(p, m.norm), q8 = rectSum8<kStep>(q, m.norm);
+    int okLo = 0, okHi = 0;
+    const __m128 vLo = norm4(_mm256_castsi256_si128(s8), _mm256_castsi256_si128(q8), area, okLo);
+    const __m128 vHi = norm4(_mm256_extracti128_si256(s8, 1), _mm256_extracti128_si256(q8, 1), area, okHi);
+    const int ok = okLo | (okHi << 4);
+    const __m256 v8 = _mm256_set_m128(vHi, vLo);
+    _mm256_store_ps(vnf, v8);
+    __m256d lo, hi;
+    stage8<kStep>(m, m.stages[0], p, v8, lo, hi);
+    _mm256_store_pd(sums, lo);
+    _mm256_store_pd(sums + 4, hi);
+    const __m256d thr0 = _mm256_set1_pd(double(m.stages[0].threshold));
+    const int pass0 = _mm256_movemask_pd(_mm256_cmp_pd(lo, thr0, _CMP_GE_OQ)) |
+                      (_mm256_movemask_pd(_mm256_cmp_pd(hi, thr0, _CMP_GE_OQ)) << 4);
+    // OpenCV's order of evaluation decides which windows exist at all.
+    int alive = 0;
+    const std::size_t stage0 = m.stages[0].end - m.stages[0].begin;
+    for (int k = 0; k < lanes; ++k) {
+      if (skipNext) {
+        skipNext = false;
+        continue;
+      }
+      ++out.windows;
+      if (!((ok >> k) & 1)) continue;
+      out.stumps += stage0;
+      if (!((pass0 >> k) & 1)) {
+        skipNext = true;
+        continue;
+      }
+      alive |= 1 << k;
+    }
+    if (!alive) continue;
+    int accepted = nStages == 1 ? alive : 0;
+    for (int s = 1; s < nStages && alive; ++s) {
+      const CvStage& st = m.stages[static_cast<std::size_t>(s)];
+      const int n = __builtin_popcount(static_cast<unsigned>(alive));
+      if (n >= 3) {
+        stage8<kStep>(m, st, p, v8, lo, hi);
+        _mm256_store_pd(sums, lo);
+        _mm256_store_pd(sums + 4, hi);
+        const __m256d thr = _mm256_set1_pd(double(st.threshold));
+        const int pass = _mm256_movemask_pd(_mm256_cmp_pd(lo, thr, _CMP_GE_OQ)) |
+                         (_mm256_movemask_pd(_mm256_cmp_pd(hi, thr, _CMP_GE_OQ)) << 4);
+        out.stumps += std::size_t(n) * (st.end - st.begin);
+        alive &= pass;
+        if (s == nStages - 1) accepted = alive;
+      } else {
+        for (int k = 0; k < lanes; ++k) {
+          if (!((alive >> k) & 1)) continue;
+          double score = 0;
+          if (runFrom(m, p + std::ptrdiff_t(k) * kStep, vnf[k], s, score, out.stumps) > 0) {
+            accepted |= 1 << k;
+            sums[k] = score;
+          }
+        }
+        alive = 0;
+      }
+    }
+    for (int k = 0; k < lanes; ++k)
+      if ((accepted >> k) & 1) out.hits.emplace_back(i0 + k, sums[k]);
+  }
+}
+
+bool cpuHasAvx2() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#endif
+
+std::atomic<bool> gVectorEnabled{true};
+
+void scanRow(const RowJob& j, RowResult& out) {
+#ifdef FUSEDET_HAVE_AVX2_PATH
+  if (gVectorEnabled.load(std::memory_order_relaxed) && cpuHasAvx2()) {
+    if (j.step == 1) scanRowAvx2<1>(j, out);
+    else scanRowAvx2<2>(j, out);
+    return;
+  }
+#endif
+  scanRowScalar(j, out);
+}
+
 cv::Mat eightBit(const Layer& l) {
   if (l.data.depth() == CV_8U) return l.data;
   cv::Mat out;
@@ -126,14 +329,18 @@ cv::Mat eightBit(const Layer& l) {
 
 }  // namespace
 
+void setVectorScanEnabled(bool enabled) { gVectorEnabled = enabled; }
+
 void integrateCv(const cv::Mat& gray, bool tilted, CvIntegrals& out) {
   const int w = gray.cols, h = gray.rows;
   out.width = w;
   out.height = h;
   const std::ptrdiff_t s = w + 1;
   const std::size_t n = static_cast<std::size_t>(s) * static_cast<std::size_t>(h + 1);
-  out.sum.assign(n, 0);
-  out.sqsum.assign(n, 0);
+  // kReadPad zeros behind each table: the 8-window vector loads may read past the last row (the
+  // lanes that do are discarded).
+  out.sum.assign(n + kReadPad, 0);
+  out.sqsum.assign(n + kReadPad, 0);
   for (int y = 0; y < h; ++y) {
     const std::uint8_t* row = gray.ptr<std::uint8_t>(y);
     const std::int32_t* prev = out.sum.data() + y * s;
@@ -169,7 +376,7 @@ void integrateCv(const cv::Mat& gray, bool tilted, CvIntegrals& out) {
       if (Y >= 2) v += I(X - 1, Y - 2) - T(X, Y - 2);
       T(X, Y) = v;
     }
-  out.tilted.assign(n, 0);
+  out.tilted.assign(n + kReadPad, 0);
   for (int Y = 0; Y <= h; ++Y)
     for (int X = 0; X <= w; ++X) out.tilted[static_cast<std::size_t>(Y * s + X)] = T(X, Y);
 }
@@ -212,7 +419,7 @@ std::vector<RawHit> scanOpenCvPyramid(const Cascade& c, const LayerStack& stack,
       buf.insert(buf.end(), in.sum.begin(), in.sum.end());
       buf.insert(buf.end(), in.tilted.begin(), in.tilted.end());
       sumBase = buf.data();
-      tiltedOffset = static_cast<std::ptrdiff_t>(in.sum.size());
+      tiltedOffset = static_cast<std::ptrdiff_t>(in.sum.size());  // includes the padding
     }
     const CvModel m = compile(c, stride, tiltedOffset);
     const int ystep = sc >= 2 ? 1 : 2;
@@ -221,23 +428,26 @@ std::vector<RawHit> scanOpenCvPyramid(const Cascade& c, const LayerStack& stack,
     const int rows = (szwH + ystep - 1) / ystep;
     std::vector<std::vector<RawHit>> hits(static_cast<std::size_t>(rows));
     std::vector<std::size_t> windows(static_cast<std::size_t>(rows), 0), stumps(static_cast<std::size_t>(rows), 0);
+    std::vector<RowResult> results(static_cast<std::size_t>(rows));
     auto row = [&](int ri) {
       const int y = ri * ystep;
-      std::size_t nw = 0, ns = 0;
+      RowJob job;
+      job.m = &m;
+      job.sum = sumBase + y * stride;
+      job.sq = in.sqsum.data() + y * stride;
+      job.positions = (szwW + ystep - 1) / ystep;
+      job.step = ystep;
+      RowResult& res = results[static_cast<std::size_t>(ri)];
+      scanRow(job, res);
       auto& h = hits[static_cast<std::size_t>(ri)];
-      for (int x = 0; x < szwW; x += ystep) {
-        const std::ptrdiff_t o = y * stride + x;
-        double score = 0;
-        ++nw;
-        const int r = runAt(m, sumBase + o, in.sqsum.data() + o, score, ns);
-        if (r > 0)
-          h.push_back(RawHit{Box{cvRoundF(float(x) * sc) * toRefX, cvRoundF(float(y) * sc) * toRefY, winW * toRefX,
-                                 winH * toRefY},
-                             score, static_cast<int>(si)});
-        if (r == 0) x += ystep;
+      for (const auto& [i, score] : res.hits) {
+        const int x = i * ystep;
+        h.push_back(RawHit{Box{cvRoundF(float(x) * sc) * toRefX, cvRoundF(float(y) * sc) * toRefY, winW * toRefX,
+                               winH * toRefY},
+                           score, static_cast<int>(si)});
       }
-      windows[static_cast<std::size_t>(ri)] = nw;
-      stumps[static_cast<std::size_t>(ri)] = ns;
+      windows[static_cast<std::size_t>(ri)] = res.windows;
+      stumps[static_cast<std::size_t>(ri)] = res.stumps;
     };
     if (params.threads == 1) {
       for (int ri = 0; ri < rows; ++ri) row(ri);

@@ -114,6 +114,33 @@ void checkParity(const std::string& name) {
 
 }  // namespace
 
+// The AVX2 path and the one-window reference path report the same hits and do the same work.
+TEST(OpenCvParity, VectorPathEqualsReferencePath) {
+  for (const char* name : {"haarcascade_frontalface_default.xml", "haarcascade_fullbody.xml", "haarcascade_eye.xml"}) {
+    const Detector det(loadOpenCvCascade(kCascades / name));
+    for (const fs::path& img : {images()[0], images()[5]}) {
+      cv::Mat gray = cv::imread(img.string(), cv::IMREAD_GRAYSCALE);
+      ASSERT_FALSE(gray.empty()) << img;
+      LayerStack stack(gray.cols, gray.rows);
+      stack.set(Layer{"intensity", gray, {}});
+      ScanParams p;
+      p.scaleFactor = 1.2;
+      ScanStats a, b;
+      setVectorScanEnabled(false);
+      const auto ref = det.scan(stack, p, &a);
+      setVectorScanEnabled(true);
+      const auto vec = det.scan(stack, p, &b);
+      ASSERT_EQ(ref.size(), vec.size()) << name << " " << img;
+      for (std::size_t i = 0; i < ref.size(); ++i) {
+        EXPECT_EQ(ref[i].box, vec[i].box);
+        EXPECT_EQ(ref[i].score, vec[i].score);
+      }
+      EXPECT_EQ(a.windows, b.windows);
+      EXPECT_EQ(a.stumps, b.stumps);
+    }
+  }
+}
+
 TEST(OpenCvParity, FrontalFaceDefault) { checkParity("haarcascade_frontalface_default.xml"); }
 TEST(OpenCvParity, FrontalFaceAlt) { checkParity("haarcascade_frontalface_alt.xml"); }
 TEST(OpenCvParity, ProfileFace) { checkParity("haarcascade_profileface.xml"); }

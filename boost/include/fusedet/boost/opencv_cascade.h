@@ -29,4 +29,9 @@ Cascade loadOpenCvCascade(const std::filesystem::path& file, const std::string& 
 Cascade parseOpenCvCascade(std::string_view xml, const std::string& source,
                            const std::string& layer = "intensity");
 
+// Scanning uses an AVX2 path (eight windows per step, the same per-window arithmetic, so the same
+// decisions) when the CPU has AVX2. Tests and benchmarks switch it off (process-wide) to compare
+// with the one-window-at-a-time reference path.
+void setVectorScanEnabled(bool enabled);
+
 }  // namespace fusedet::boosting
