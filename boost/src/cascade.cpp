@@ -44,12 +44,13 @@ void Cascade::validate() const {
     if (h.count < 2 || h.count > 3) fail("feature " + std::to_string(i) + " has " + std::to_string(h.count) + " rectangles, expected 2 or 3");
     for (int r = 0; r < h.count; ++r) {
       const HaarRect& q = h.rects[static_cast<std::size_t>(r)];
+      // 64-bit: imported numbers may be large; the sums must not overflow.
+      const long long x = q.x, y = q.y, w = q.w, hh = q.h, W = windowWidth, H = windowHeight;
       bool inside;
       if (!h.tilted) {
-        inside = q.x >= 0 && q.y >= 0 && q.w > 0 && q.h > 0 && q.x + q.w <= windowWidth && q.y + q.h <= windowHeight;
+        inside = x >= 0 && y >= 0 && w > 0 && hh > 0 && x + w <= W && y + hh <= H;
       } else {  // corners: top (x, y), right (x + w, y + w), left (x - h, y + h), bottom (x + w - h, y + w + h)
-        inside = q.w > 0 && q.h > 0 && q.y >= 0 && q.x - q.h >= 0 && q.x + q.w <= windowWidth &&
-                 q.y + q.w + q.h <= windowHeight;
+        inside = w > 0 && hh > 0 && y >= 0 && x - hh >= 0 && x + w <= W && y + w + hh <= H;
       }
       if (!inside) fail("feature " + std::to_string(i) + " rectangle " + std::to_string(r) + " lies outside the " +
                         std::to_string(windowWidth) + "x" + std::to_string(windowHeight) + " window");
