@@ -141,6 +141,28 @@ TEST(OpenCvParity, VectorPathEqualsReferencePath) {
   }
 }
 
+// Threads split rows; the merged output is the single-threaded one, in order and value.
+TEST(OpenCvParity, MultiThreadedScanIsIdenticalToSingleThreaded) {
+  const Detector det(loadOpenCvCascade(kCascades / "haarcascade_eye.xml"));
+  const cv::Mat gray = cv::imread(images()[0].string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(gray.empty());
+  LayerStack stack(gray.cols, gray.rows);
+  stack.set(Layer{"intensity", gray, {}});
+  ScanParams p;
+  p.threads = 1;
+  const auto one = det.scan(stack, p);
+  ASSERT_GT(one.size(), 5u);
+  for (int threads : {0, 2, 3}) {
+    p.threads = threads;
+    const auto many = det.scan(stack, p);
+    ASSERT_EQ(many.size(), one.size());
+    for (std::size_t i = 0; i < one.size(); ++i) {
+      EXPECT_EQ(many[i].box, one[i].box);
+      EXPECT_EQ(many[i].score, one[i].score);
+    }
+  }
+}
+
 TEST(OpenCvParity, FrontalFaceDefault) { checkParity("haarcascade_frontalface_default.xml"); }
 TEST(OpenCvParity, FrontalFaceAlt) { checkParity("haarcascade_frontalface_alt.xml"); }
 TEST(OpenCvParity, ProfileFace) { checkParity("haarcascade_profileface.xml"); }
