@@ -13,6 +13,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 // After a NAK the device wants >= 30 ms before the request is sent again (§2).
 constexpr auto kNakPause = std::chrono::milliseconds(30);
+constexpr int kNakRetries = 3;
 }  // namespace
 
 Result<void> Link::open(const std::string& path, int baud) {
@@ -76,7 +77,10 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
   const std::vector<std::uint8_t> bytes = encodeRequest(command, data);
   const std::uint8_t expected = command | kReplyBit;
   ++counters_.requests;
-  for (int attempt = 0; attempt <= o.retries; ++attempt) {
+  // Silence uses up `retries`; a NAK proves the device is listening, so NAKs get their own
+  // (bounded) budget: a probe without retries still survives a refused first request.
+  int silentAttempts = 0, nakAttempts = 0;
+  for (int attempt = 0; silentAttempts <= o.retries && nakAttempts <= std::max(o.retries, kNakRetries); ++attempt) {
     if (attempt > 0) ++counters_.retries;
     // Line time of the request itself: at 9600 baud a long request takes tens of ms.
     const auto sendTime = std::chrono::microseconds(static_cast<std::int64_t>(byteSeconds(port_.baud()) * 1e6 * bytes.size()));
@@ -88,6 +92,7 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
       if (!ev) return ev.error();
       if (!*ev) {
         ++counters_.timeouts;
+        ++silentAttempts;
         break;
       }
       const StreamEvent& e = **ev;
@@ -96,6 +101,7 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
         acked = true;
       } else if (e.kind == StreamEvent::Kind::kNakByte) {
         ++counters_.naks;
+        ++nakAttempts;
         nak = true;
         break;
       } else if (e.kind == StreamEvent::Kind::kTelegram) {
@@ -113,8 +119,9 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
     }
     if (nak) std::this_thread::sleep_for(kNakPause);
   }
-  char what[64];
-  std::snprintf(what, sizeof what, "no reply to command 0x%02X after %d attempts", command, o.retries + 1);
+  char what[128];
+  std::snprintf(what, sizeof what, "no reply to command 0x%02X (%d silent, %d refused with NAK)", command,
+                silentAttempts, nakAttempts);
   return makeError(std::errc::timed_out, what);
 }
 

@@ -50,6 +50,7 @@ void TelegramReader::clear() {
   bufferOffset_ += buffer_.size();
   buffer_.clear();
   inGarbage_ = false;
+  releaseLone_ = false;
 }
 
 void TelegramReader::skip(std::size_t n) {
@@ -79,6 +80,14 @@ std::optional<StreamEvent> TelegramReader::next() {
   while (!buffer_.empty()) {
     const std::uint8_t b = buffer_.front();
     if (b == kAck || b == kNak) {
+      // A lone ACK/NAK stands between telegrams: next comes an STX or silence. Without that
+      // context a 06/15 is most likely a data byte of a telegram we joined in the middle.
+      if (buffer_.size() == 1 && !releaseLone_) return std::nullopt;
+      if (buffer_.size() > 1 && buffer_[1] != kStx) {
+        skip(1);
+        continue;
+      }
+      releaseLone_ = false;
       StreamEvent e;
       e.kind = b == kAck ? StreamEvent::Kind::kAckByte : StreamEvent::Kind::kNakByte;
       e.offset = bufferOffset_;
@@ -136,6 +145,10 @@ std::optional<StreamEvent> TelegramReader::next() {
 
 bool TelegramReader::expirePending() {
   if (buffer_.empty()) return false;
+  if (buffer_.size() == 1 && (buffer_[0] == kAck || buffer_[0] == kNak) && !releaseLone_) {
+    releaseLone_ = true;  // silence after it: a real ACK/NAK
+    return true;
+  }
   // Whatever is left cannot complete: drop its first byte and let next() rescan the rest.
   ++counters_.expired;
   skip(1);

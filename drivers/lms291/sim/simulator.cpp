@@ -76,6 +76,8 @@ void Simulator::powerOn() {
   out_.clear();
   outPos_ = 0;
   outDamaged_ = false;
+  outDropped_ = false;
+  lineBytes_.clear();
   reader_.clear();
   rotation_ = 0;
   telegramIndex_ = 0;
@@ -127,6 +129,16 @@ SimState Simulator::state() const {
   return s;
 }
 
+std::vector<std::uint64_t> Simulator::crcBlindScans() const {
+  std::lock_guard lock(mutex_);
+  return crcBlindScans_;
+}
+
+std::vector<std::uint64_t> Simulator::damagedScans() const {
+  std::lock_guard lock(mutex_);
+  return damagedScans_;
+}
+
 void Simulator::setFaults(const Faults& f) {
   std::lock_guard lock(mutex_);
   faults_ = f;
@@ -174,6 +186,7 @@ void Simulator::reply(std::uint8_t command, std::vector<std::uint8_t> data, Cloc
   o.telegram = true;
   o.scan = command == kMeasuredValues || command == kRangeRemission;
   o.baudAfter = baudAfter;
+  o.scanNumber = scansQueued_;
   out_.push_back(std::move(o));
 }
 
@@ -376,6 +389,7 @@ void Simulator::pumpOutput(Clock::time_point now) {
       if (faults_.dropRate > 0 && std::uniform_real_distribution<>(0, 1)(rng_) < faults_.dropRate) {
         ++counters_.droppedBytes;
         outDamaged_ = true;
+        outDropped_ = true;
         continue;
       }
       if (faults_.bitFlipRate > 0 && std::uniform_real_distribution<>(0, 1)(rng_) < faults_.bitFlipRate) {
@@ -385,6 +399,7 @@ void Simulator::pumpOutput(Clock::time_point now) {
       }
       bytes.push_back(b);
     }
+    if (o.telegram) lineBytes_.insert(lineBytes_.end(), bytes.begin(), bytes.end());
     if (!bytes.empty()) {
       if (hostBaud() == baud_) {
         const ssize_t n = ::write(master_.get(), bytes.data(), bytes.size());
@@ -394,7 +409,8 @@ void Simulator::pumpOutput(Clock::time_point now) {
       }
       counters_.bytesOut += bytes.size();
     }
-    lineFreeAt_ = std::max(lineFreeAt_, now) +
+    // A UART sends at a constant rate: if this thread woke late, catch up (within 2 ms).
+    lineFreeAt_ = std::max(lineFreeAt_, now - std::chrono::milliseconds(2)) +
                   std::chrono::nanoseconds(static_cast<std::int64_t>(byteSeconds(baud_) * 1e9 * static_cast<double>(chunk)));
     outPos_ += chunk;
     if (outPos_ < o.bytes.size()) continue;
@@ -403,13 +419,24 @@ void Simulator::pumpOutput(Clock::time_point now) {
       if (o.scan) ++counters_.scansOut;
       if (outDamaged_) {
         ++counters_.telegramsDamaged;
-        if (o.scan) ++counters_.scansDamaged;
+        if (o.scan) {
+          ++counters_.scansDamaged;
+          if (damagedScans_.size() < 1'000'000) damagedScans_.push_back(o.scanNumber);
+          const std::size_t n = lineBytes_.size();
+          if (!outDropped_ && n >= kFrameOverhead &&
+              crc16(std::span(lineBytes_).first(n - 2)) == (lineBytes_[n - 2] | (lineBytes_[n - 1] << 8))) {
+            ++counters_.scansCrcBlind;
+            crcBlindScans_.push_back(o.scanNumber);
+          }
+        }
       }
     }
     if (o.baudAfter) baud_ = o.baudAfter;
     out_.pop_front();
     outPos_ = 0;
     outDamaged_ = false;
+    outDropped_ = false;
+    lineBytes_.clear();
   }
 }
 

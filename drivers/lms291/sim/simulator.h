@@ -65,6 +65,8 @@ struct SimCounters {
   std::uint64_t scansSkipped = 0;      // scans not sent because the line was busy
   std::uint64_t telegramsDamaged = 0;  // telegrams with >= 1 flipped or dropped byte
   std::uint64_t scansDamaged = 0;      // of them measured-value telegrams
+  // Damaged scans whose CRC still matches (bit flips only, no drops): no receiver can reject them.
+  std::uint64_t scansCrcBlind = 0;
   std::uint64_t bitFlips = 0;
   std::uint64_t droppedBytes = 0;
   std::uint64_t garbageBytes = 0;
@@ -107,6 +109,9 @@ class Simulator {
   void nakStorm(int requests);                    // the next `requests` valid requests get NAK
   void silence(std::chrono::milliseconds d);      // neither reads nor writes for d
   void vanish(std::chrono::milliseconds d);       // pty gone for d, then power-on again
+  // Numbers (see SimOptions::counterBeam) of the scans that went out damaged, in order.
+  std::vector<std::uint64_t> damagedScans() const;
+  std::vector<std::uint64_t> crcBlindScans() const;  // damaged but with a matching CRC
 
  private:
   struct Output {
@@ -115,6 +120,7 @@ class Simulator {
     bool telegram = false;
     bool scan = false;
     int baudAfter = 0;  // switch the device speed once these bytes are on the line
+    std::uint64_t scanNumber = 0;  // scans: how many scans were queued before this one
   };
   using Clock = std::chrono::steady_clock;
 
@@ -156,6 +162,8 @@ class Simulator {
   std::deque<Output> out_;
   std::size_t outPos_ = 0;       // bytes of out_.front() already sent
   bool outDamaged_ = false;      // current telegram got a fault
+  bool outDropped_ = false;      // ... and lost a byte
+  std::vector<std::uint8_t> lineBytes_;  // current telegram as it went on the line
   Faults faults_;
   int nakStorm_ = 0;
   Clock::time_point silentUntil_;
@@ -164,6 +172,8 @@ class Simulator {
   std::uint64_t scansQueued_ = 0;
   bool present_ = false;
   SimCounters counters_;
+  std::vector<std::uint64_t> damagedScans_;
+  std::vector<std::uint64_t> crcBlindScans_;
 };
 
 }  // namespace fusedet::drivers::lms291::sim

@@ -49,8 +49,8 @@ std::vector<std::uint8_t> encodeRequest(std::uint8_t command, std::span<const st
 // What the reader found in the stream.
 struct StreamEvent {
   enum class Kind {
-    kAckByte,     // lone 0x06 between telegrams
-    kNakByte,     // lone 0x15 between telegrams
+    kAckByte,     // lone 0x06 between telegrams (followed by STX or silence)
+    kNakByte,     // lone 0x15 between telegrams (followed by STX or silence)
     kTelegram,  // a complete telegram with a valid CRC
     kBadCrc,    // a plausible frame whose CRC failed (raw bytes kept for diagnostics)
   };
@@ -87,8 +87,9 @@ class TelegramReader {
   // Next event, or nothing when more bytes are needed.
   std::optional<StreamEvent> next();
   // After a silence: give up a frame that waits for bytes that will not come (e.g. a garbage
-  // STX with a large "length"); the bytes after its STX are searched again. Returns true if a
-  // frame was pending.
+  // STX with a large "length"); the bytes after its STX are searched again. A trailing lone
+  // ACK/NAK byte is released as such (next() waits for the byte after it, or this silence).
+  // Returns true if anything was pending.
   bool expirePending();
   // Drop everything buffered (e.g. after a port re-open or a baud change).
   void clear();
@@ -105,6 +106,7 @@ class TelegramReader {
   std::size_t bufferOffset_ = 0;  // stream offset of buffer_[0]
   Stamp lastFeed_;
   bool inGarbage_ = false;
+  bool releaseLone_ = false;  // a trailing ACK/NAK byte was followed by silence
   ReaderCounters counters_;
 };
 
