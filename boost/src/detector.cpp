@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <tuple>
 
 
 namespace fusedet::boosting {
@@ -20,14 +21,17 @@ int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
 
 // One stump with its feature laid out for one scale: rectangle corners as offsets from the
 // window's origin in its layer's integral (OpenCV's OptFeature idea), flat for the hot loop.
+// Branch-free form of FeatureLayout (stump types mix unpredictably): black = rect 0 + rect 1
+// (rect 1 is an empty rectangle, sum exactly 0, unless the type has two black parts), white =
+// rect 2 - rest * black with rest = 1 when rect 2 is the outer rectangle, else 0. Same values as
+// featureValue() (adding or subtracting an exact zero changes nothing but the sign of a zero).
 struct ScaledStump {
   int layer = 0;
-  int blackCount = 1;
-  bool whiteIsRest = false;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};  // (x0,y0) (x1,y0) (x0,y1) (x1,y1)
+  double rest = 0;
   double blackArea = 1, whiteArea = 1;
   float threshold = 0;
-  double left = 0, right = 0;
+  std::array<double, 2> leaf{};  // left, right: indexed, not branched on
 };
 
 struct ScaledStage {
@@ -83,19 +87,19 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
         const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lwSize[l][0], lwSize[l][1]));
         ScaledStump z;
         z.layer = f.layer;
-        z.blackCount = lay.blackCount;
-        z.whiteIsRest = lay.whiteIsRest;
+        z.rest = lay.whiteIsRest ? 1.0 : 0.0;
         z.blackArea = lay.blackArea;
         z.whiteArea = lay.whiteArea;
-        for (int i = 0; i < lay.count(); ++i) {
-          const PixelRect& r = lay.rects[static_cast<std::size_t>(i)];
-          z.ofs[static_cast<std::size_t>(i)] = {
+        auto corners = [stride](const PixelRect& r) {
+          return std::array<std::int32_t, 4>{
               static_cast<std::int32_t>(r.y0 * stride + r.x0), static_cast<std::int32_t>(r.y0 * stride + r.x1),
               static_cast<std::int32_t>(r.y1 * stride + r.x0), static_cast<std::int32_t>(r.y1 * stride + r.x1)};
-        }
+        };
+        z.ofs[0] = corners(lay.rects[0]);
+        z.ofs[1] = lay.blackCount == 2 ? corners(lay.rects[1]) : std::array<std::int32_t, 4>{0, 0, 0, 0};
+        z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
         z.threshold = static_cast<float>(t.threshold);
-        z.left = t.left;
-        z.right = t.right;
+        z.leaf = {t.left, t.right};
         sp.stumps.push_back(z);
       }
       ss.end = sp.stumps.size();
@@ -115,11 +119,10 @@ inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, st
       const ScaledStump& z = sp.stumps[k];
       const double* p = base[z.layer];
       auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
-      const double black = z.blackCount == 2 ? rs(z.ofs[0]) + rs(z.ofs[1]) : rs(z.ofs[0]);
-      const double last = rs(z.ofs[static_cast<std::size_t>(z.blackCount)]);
-      const double white = z.whiteIsRest ? last - black : last;
+      const double black = rs(z.ofs[0]) + rs(z.ofs[1]);
+      const double white = rs(z.ofs[2]) - z.rest * black;
       const auto v = static_cast<float>(black / z.blackArea - white / z.whiteArea);
-      sum += v < z.threshold ? z.left : z.right;
+      sum += z.leaf[static_cast<std::size_t>(!(v < z.threshold))];
     }
     stumps += st.end - st.begin;
     r.score = sum;
@@ -190,30 +193,45 @@ std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& pa
     throw std::invalid_argument("Detector::scan: integrals hold " + std::to_string(in.size()) +
                                 " layers, the model reads " + std::to_string(cascade_.layers.size()));
   const std::vector<ScalePlan> plans = planScales(cascade_, in, params);
-  // Rows of all scales in one index space so that threads share the work across scales.
-  std::vector<std::pair<std::size_t, std::size_t>> rows;
+  // Work items: a band of columns of one scale, all its rows. Bands keep the integral rows a
+  // window touches in cache while y advances (a whole image row of 7 double layers does not fit);
+  // all scales share one index space so that threads share the work across scales.
+  constexpr std::size_t kBand = 48;  // window positions per band
+  struct Item {
+    std::size_t scale, x0, x1;
+  };
+  std::vector<Item> items;
   for (std::size_t s = 0; s < plans.size(); ++s)
-    for (std::size_t y = 0; y < plans[s].ys.size(); ++y) rows.emplace_back(s, y);
-  std::vector<std::vector<RawHit>> hits(rows.size());
-  std::vector<std::size_t> stumpCount(rows.size(), 0);
+    for (std::size_t x0 = 0; x0 < plans[s].xs.size(); x0 += kBand)
+      items.push_back(Item{s, x0, std::min(plans[s].xs.size(), x0 + kBand)});
+  std::vector<std::vector<RawHit>> hits(items.size());
+  std::vector<std::size_t> stumpCount(items.size(), 0);
   const std::size_t nl = in.size();
-  forEachRow(rows.size(), params.threads, [&](std::size_t i) {
-    const auto [s, yi] = rows[i];
-    const ScalePlan& sp = plans[s];
-    std::vector<const double*> base(nl);
+  std::vector<const double*> layerData(nl);
+  for (std::size_t l = 0; l < nl; ++l) layerData[l] = in.layer(l).sum.data();
+  forEachRow(items.size(), params.threads, [&](std::size_t i) {
+    const Item& it = items[i];
+    const ScalePlan& sp = plans[it.scale];
+    std::vector<const double*> base(nl), rowBase(nl);
     std::size_t stumps = 0;
-    for (std::size_t xi = 0; xi < sp.xs.size(); ++xi) {
-      for (std::size_t l = 0; l < nl; ++l)
-        base[l] = in.layer(l).sum.data() + sp.rowOfs[l][yi] + sp.colOfs[l][xi];
-      const WindowResult r = runWindow(sp, base.data(), stumps);
-      if (r.accepted)
-        hits[i].push_back(RawHit{Box{double(sp.xs[xi]), double(sp.ys[yi]), double(sp.winW), double(sp.winH)},
-                                 r.score, static_cast<int>(s)});
+    for (std::size_t yi = 0; yi < sp.ys.size(); ++yi) {
+      for (std::size_t l = 0; l < nl; ++l) rowBase[l] = layerData[l] + sp.rowOfs[l][yi];
+      for (std::size_t xi = it.x0; xi < it.x1; ++xi) {
+        for (std::size_t l = 0; l < nl; ++l) base[l] = rowBase[l] + sp.colOfs[l][xi];
+        const WindowResult r = runWindow(sp, base.data(), stumps);
+        if (r.accepted)
+          hits[i].push_back(RawHit{Box{double(sp.xs[xi]), double(sp.ys[yi]), double(sp.winW), double(sp.winH)},
+                                   r.score, static_cast<int>(it.scale)});
+      }
     }
     stumpCount[i] = stumps;
   });
+  // (scale, row, column) order, whatever the bands and threads: each window occurs once.
   std::vector<RawHit> out;
   for (auto& h : hits) out.insert(out.end(), h.begin(), h.end());
+  std::sort(out.begin(), out.end(), [](const RawHit& a, const RawHit& b) {
+    return std::tie(a.scale, a.box.y, a.box.x) < std::tie(b.scale, b.box.y, b.box.x);
+  });
   if (stats) {
     stats->scales += plans.size();
     for (const ScalePlan& sp : plans) stats->windows += sp.xs.size() * sp.ys.size();
