@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "fusedet/boost/reference_hue.h"
+#include "fusedet/boost/sample_features.h"
 
 namespace fusedet::boosting {
 
@@ -126,6 +127,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     const NegativeHarvest harvest = stacks.harvestNegatives(
         cascade, stage > config.maxStages ? 0 : wanted, config.seed * 1000003ULL + std::uint64_t(stage),
         config.threads);
+    const double harvestSeconds = std::chrono::duration<double>(Clock::now() - ts).count();
     if (stage == 1) initialCandidates = std::max<std::size_t>(1, harvest.candidates);
     const double cascadeFa = double(harvest.candidates) / double(initialCandidates);
     report.finalFalseAlarm = cascadeFa;
@@ -182,21 +184,15 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     progress.onProgress(ev);
 
     // The pool on every sample, once per stage.
+    const auto tm = Clock::now();
+    const SampleFeatures values(stacks, pool, samples);
     const FeatureMatrix matrix = buildFeatureMatrix(
         pool.size(), n,
-        [&](std::size_t first, std::size_t count, std::span<float> out) {
-          std::vector<float> v(count);
-          const std::span<const Feature> block(pool.data() + first, count);
-          for (std::size_t i = 0; i < n; ++i) {
-            featureValues(stacks.integrals(samples[i].stack), block, samples[i].window, v);
-            for (std::size_t k = 0; k < count; ++k) out[k * n + i] = v[k];
-          }
-        },
-        config.threads, 256);
-    const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) {
-      for (std::size_t i = 0; i < n; ++i)
-        out[i] = featureValue(stacks.integrals(samples[i].stack), pool[f], samples[i].window);
-    };
+        [&](std::size_t first, std::size_t count, std::span<float> out) { values.block(first, count, out); },
+        config.threads, 1024);
+    const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) { values.feature(f, out); };
+    const auto tb = Clock::now();
+    const double matrixSeconds = std::chrono::duration<double>(tb - tm).count();
     StageConfig sc = config.stage;
     sc.threads = config.threads;
     const StageResult r = trainStage(matrix, positives, raw, sc, [&](const RoundInfo& info) {
@@ -229,6 +225,9 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     sr.negativeCandidates = harvest.candidates;
     sr.cascadeFalseAlarm = cascadeFa;
     sr.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
+    sr.harvestSeconds = harvestSeconds;
+    sr.matrixSeconds = matrixSeconds;
+    sr.boostSeconds = std::chrono::duration<double>(Clock::now() - tb).count();
     report.stages.push_back(sr);
 
     ev.kind = ProgressKind::kStageDone;
@@ -240,7 +239,9 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                  (r.reachedFalseAlarm ? "" : " (round limit)") + ", " + std::to_string(positives) +
                  " positives, " + std::to_string(sr.negatives) + " negatives of " +
                  std::to_string(harvest.candidates) + " candidates in " +
-                 std::to_string(harvest.windowsScanned) + " windows, " + fixed(sr.seconds, 1) + " s";
+                 std::to_string(harvest.windowsScanned) + " windows, " + fixed(sr.seconds, 1) + " s (scan " +
+                 fixed(sr.harvestSeconds, 1) + ", features " + fixed(sr.matrixSeconds, 1) + ", boosting " +
+                 fixed(sr.boostSeconds, 1) + ")";
     progress.onProgress(ev);
   }
 

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <cstring>
 #include <random>
 
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/model_io.h"
+#include "fusedet/boost/sample_features.h"
 
 using namespace fusedet;
 using namespace fusedet::boosting;
@@ -206,4 +208,46 @@ TEST(CascadeTrainer, NegativeWindowsAvoidLabelsAndIgnoreRegions) {
   EXPECT_TRUE(isPositiveLabel(small, s));
   small.occlusion = 2;
   EXPECT_FALSE(isPositiveLabel(small, s));
+}
+
+TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
+  // Two layers at different resolutions; windows of repeated and distinct sizes.
+  std::vector<DatasetItem> items;
+  for (unsigned s = 0; s < 3; ++s) {
+    DatasetItem it = scene(300 + s, 2, false);
+    cv::Mat half;
+    cv::resize(it.stack.at("intensity").data, half, cv::Size(100, 60));
+    cv::Mat f;
+    half.convertTo(f, CV_32F, 0.37, -3.1);
+    it.stack.set(Layer{"distance", f, {}});
+    items.push_back(it);
+  }
+  SampleConfig sc;
+  sc.minPositiveHeight = 20;
+  const TrainingStacks stacks(items, {"intensity", "distance"}, std::nullopt, sc);
+  PoolConfig pc;
+  pc.grid = 7;
+  pc.layers = {"intensity", "distance"};
+  const auto pool = generatePool(pc);
+  std::vector<Sample> samples = stacks.positives();
+  std::mt19937 rng(3);
+  for (int k = 0; k < 40; ++k) {
+    const double w = 20 + double(rng() % 4) * 7.3, h = w * 0.6;
+    samples.push_back(Sample{std::uint32_t(rng() % stacks.size()),
+                             Box{double(rng() % 150), double(rng() % 80), w, h}});
+  }
+  const SampleFeatures sf(stacks, pool, samples);
+  const std::size_t first = 13, count = pool.size() - 20, n = samples.size();
+  std::vector<float> out(count * n);
+  sf.block(first, count, out);
+  std::size_t mismatches = 0;
+  for (std::size_t k = 0; k < count; ++k)
+    for (std::size_t i = 0; i < n; ++i) {
+      const float ref = featureValue(stacks.integrals(samples[i].stack), pool[first + k], samples[i].window);
+      mismatches += std::memcmp(&ref, &out[k * n + i], sizeof ref) != 0;
+    }
+  EXPECT_EQ(mismatches, 0u) << "of " << count * n;
+  std::vector<float> one(n);
+  sf.feature(first + 5, one);
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(one[i], out[5 * n + i]);
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <array>
 #include <limits>
 #include <random>
 
@@ -90,8 +91,14 @@ TEST(BinEdges, FewDistinctValuesGetOneBinEach) {
   EXPECT_EQ(e, (std::vector<float>{2, 3, 5}));
   FeatureMatrix m(1, v.size());
   m.setFeature(0, v);
-  const std::uint8_t expected[] = {2, 0, 1, 1, 3, 0, 2};
+  const std::uint8_t expected[] = {2, 0, 1, 1, 3, 0, 2};  // dense ranks of the distinct values
   for (std::size_t i = 0; i < v.size(); ++i) EXPECT_EQ(m.row(0)[i], expected[i]) << i;
+  // Negative values, zero signs and NaN keep their order (NaN last).
+  const std::vector<float> w = {-0.5f, 2.f, -3.f, 0.f, NAN, 1e-30f};
+  FeatureMatrix m2(1, w.size());
+  m2.setFeature(0, w);
+  const std::uint8_t expected2[] = {1, 4, 0, 2, 5, 3};
+  for (std::size_t i = 0; i < w.size(); ++i) EXPECT_EQ(m2.row(0)[i], expected2[i]) << i;
 }
 
 TEST(BinEdges, ManyValuesGiveOrderPreservingBins) {
@@ -103,12 +110,17 @@ TEST(BinEdges, ManyValuesGiveOrderPreservingBins) {
   EXPECT_TRUE(std::is_sorted(e.begin(), e.end()));
   FeatureMatrix m(1, v.size());
   m.setFeature(0, v);
-  for (std::size_t i = 0; i < v.size(); ++i)
+  std::size_t bad = 0;
+  std::array<int, 256> perBin{};
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    perBin[m.row(0)[i]]++;
     for (std::size_t j = 0; j < v.size(); j += 97) {
-      if (v[i] < v[j]) {
-        EXPECT_LE(m.row(0)[i], m.row(0)[j]);
-      }
+      bad += (v[i] < v[j] && m.row(0)[i] > m.row(0)[j]) || (v[i] == v[j] && m.row(0)[i] != m.row(0)[j]);
     }
+  }
+  EXPECT_EQ(bad, 0u);
+  // Equal-count quantiles: 5000 / 256 = 19.5 values per bin.
+  for (int b = 0; b < 256; ++b) EXPECT_NEAR(perBin[b], 5000.0 / 256, 2) << b;
 }
 
 TEST(Stump, ExactFitEqualsBruteForce) {

@@ -55,6 +55,8 @@ struct StageReport {
   std::size_t negativeCandidates = 0;  // label-free windows the cascade accepted then
   double cascadeFalseAlarm = 1;        // candidates / candidates before stage 1
   double seconds = 0;
+  // Where the time went: bootstrapping scan, pool evaluation + binning, boosting rounds.
+  double harvestSeconds = 0, matrixSeconds = 0, boostSeconds = 0;
 };
 
 struct TrainingReport {

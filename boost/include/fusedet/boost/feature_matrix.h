@@ -16,14 +16,14 @@ namespace fusedet::boosting {
 class FeatureMatrix {
  public:
   static constexpr int kMaxBins = 256;
-  // Bin edges are quantiles of at most this many values per feature (an evenly strided subsample),
-  // so binning costs O(kEdgeSample log kEdgeSample + samples * 8) per feature.
-  static constexpr std::size_t kEdgeSample = 1024;
+  static constexpr std::size_t kEdgeSample = 1024;  // values binEdges() looks at
 
   FeatureMatrix() = default;
   FeatureMatrix(std::size_t features, std::size_t samples);
 
-  // Quantises the raw values of feature f (one per sample) into row f. Thread-safe for distinct f.
+  // Quantises the raw values of feature f (one per sample) into row f: samples ranked by value
+  // (radix sort), equal values share a bin, bins are equal-count quantiles (or one bin per value
+  // when there are at most kMaxBins distinct values). Thread-safe for distinct f.
   void setFeature(std::size_t f, std::span<const float> values);
 
   std::size_t features() const { return features_; }
@@ -46,8 +46,9 @@ FeatureMatrix buildFeatureMatrix(std::size_t features, std::size_t samples,
                                  const FeatureBlockFn& values, int threads = 0,
                                  std::size_t block = 512);
 
-// Quantile bin edges of one feature's values (sorted, strictly increasing, at most kMaxBins - 1):
-// a value v falls into bin = number of edges <= v. Exposed for tests.
+// Quantile bin edges of a strided subsample of one feature's values (sorted, strictly increasing,
+// at most kMaxBins - 1; v falls into bin = number of edges <= v): for callers that bin values
+// the matrix has not seen.
 std::vector<float> binEdges(std::span<const float> values);
 
 }  // namespace fusedet::boosting

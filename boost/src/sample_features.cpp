@@ -1,0 +1,76 @@
+#include "fusedet/boost/sample_features.h"
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+
+namespace fusedet::boosting {
+
+SampleFeatures::SampleFeatures(const TrainingStacks& stacks, std::span<const Feature> pool,
+                               std::span<const Sample> samples)
+    : stacks_(stacks), pool_(pool), samples_(samples) {
+  const std::size_t n = samples.size();
+  layers_ = stacks.size() ? stacks.integrals(0).size() : 0;
+  windows_.resize(n * layers_);
+  for (std::size_t i = 0; i < n; ++i) {
+    const IntegralStack& is = stacks.integrals(samples[i].stack);
+    if (is.size() != layers_) throw std::invalid_argument("SampleFeatures: stacks differ in layer count");
+    for (std::size_t l = 0; l < layers_; ++l)
+      windows_[i * layers_ + l] = layerWindow(is.layer(l), is.width(), is.height(), samples[i].window);
+  }
+  auto sizeLess = [&](std::size_t a, std::size_t b) {
+    for (std::size_t l = 0; l < layers_; ++l) {
+      const LayerWindow &wa = windows_[a * layers_ + l], &wb = windows_[b * layers_ + l];
+      if (wa.w != wb.w) return wa.w < wb.w;
+      if (wa.h != wb.h) return wa.h < wb.h;
+    }
+    return false;
+  };
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), std::size_t{0});
+  std::stable_sort(order_.begin(), order_.end(), sizeLess);
+  for (std::size_t k = 0; k < n; ++k)
+    if (k == 0 || sizeLess(order_[k - 1], order_[k])) runStart_.push_back(k);
+  runStart_.push_back(n);
+}
+
+void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float> out) const {
+  const std::size_t n = samples_.size();
+  std::vector<FeatureLayout> layouts(count);
+  for (std::size_t r = 0; r + 1 < runStart_.size(); ++r) {
+    // Layouts relative to the window origin, shared by the whole group (layoutFeature is
+    // translation invariant: it only uses differences of the outer rectangle's edges).
+    const std::size_t rep = order_[runStart_[r]];
+    for (std::size_t k = 0; k < count; ++k) {
+      const Feature& f = pool_[first + k];
+      const LayerWindow& lw = windows_[rep * layers_ + static_cast<std::size_t>(f.layer)];
+      layouts[k] = layoutFeature(f.type, featureRectInWindow(f, lw.w, lw.h));
+    }
+    for (std::size_t q = runStart_[r]; q < runStart_[r + 1]; ++q) {
+      const std::size_t i = order_[q];
+      const IntegralStack& is = stacks_.integrals(samples_[i].stack);
+      for (std::size_t k = 0; k < count; ++k) {
+        const auto layer = static_cast<std::size_t>(pool_[first + k].layer);
+        const LayerIntegral& li = is.layer(layer);
+        const LayerWindow& lw = windows_[i * layers_ + layer];
+        const FeatureLayout& l = layouts[k];
+        // Same arithmetic, in the same order, as featureValue().
+        auto rs = [&](int j) {
+          const PixelRect& p = l.rects[static_cast<std::size_t>(j)];
+          return li.rectSum(p.x0 + lw.x, p.y0 + lw.y, p.x1 + lw.x, p.y1 + lw.y);
+        };
+        const double black = l.blackCount == 2 ? rs(0) + rs(1) : rs(0);
+        const double last = rs(l.blackCount);
+        const double white = l.whiteIsRest ? last - black : last;
+        out[k * n + i] = static_cast<float>(black / l.blackArea - white / l.whiteArea);
+      }
+    }
+  }
+}
+
+void SampleFeatures::feature(std::size_t f, std::span<float> out) const {
+  for (std::size_t i = 0; i < samples_.size(); ++i)
+    out[i] = featureValue(stacks_.integrals(samples_[i].stack), pool_[f], samples_[i].window);
+}
+
+}  // namespace fusedet::boosting

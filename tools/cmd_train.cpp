@@ -1,0 +1,311 @@
+// fusedet train: trains one class's cascade on a data set (boost/cascade_trainer.h) and writes the
+// model file (boost/model_io.h). Progress: a live status line on a terminal, plain log lines
+// otherwise.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "command.h"
+#include "fusedet/boost/cascade_trainer.h"
+#include "fusedet/boost/model_io.h"
+#include "fusedet/core/dataset.h"
+
+namespace fusedet::tools {
+namespace {
+
+struct TrainOptions {
+  std::filesystem::path data;
+  std::filesystem::path out;
+  std::string className = "car";
+  std::string layers = "red,green,blue,intensity,hue_distance,distance,remission";
+  std::string types = "all";
+  int grid = 16, positionStep = 1, sizeStep = 1, minCell = 1;
+  int windowHeight = 24;
+  double minHit = 0.995, maxFa = 0.5, targetFa = 1e-5;
+  int stages = 20, rounds = 100;
+  std::size_t negatives = 0;
+  double minHeight = 25;
+  int maxOcclusion = 1;
+  bool noFlip = false;
+  double scaleFactor = 1.2, step = 2;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  double split = 2.0 / 3.0;
+  std::vector<std::string> groups, trainOnly;
+  std::filesystem::path testList;
+  std::string progress = "auto";
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::string clock(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+
+// Status line on a terminal, log lines otherwise. ETA: stages still needed to reach the target
+// false-alarm rate at max_fa per stage (bounded by the stage limit) times the mean stage time.
+class ConsoleProgress final : public boosting::ProgressSink {
+ public:
+  ConsoleProgress(bool tty, double maxFa, double targetFa) : tty_(tty), maxFa_(maxFa), targetFa_(targetFa) {}
+
+  void onProgress(const boosting::ProgressEvent& e) override {
+    using boosting::ProgressKind;
+    switch (e.kind) {
+      case ProgressKind::kStart:
+      case ProgressKind::kFinished:
+        line(e.message);
+        break;
+      case ProgressKind::kStageDone:
+        stageSeconds_.push_back(e.elapsedSeconds - stageStart_);
+        line(e.message);
+        break;
+      case ProgressKind::kNegatives:
+        stageStart_ = e.elapsedSeconds;
+        found_ = e.negatives;
+        scanned_ = e.windowsScanned;
+        cascadeFa_ = e.cascadeFalseAlarm;
+        if (!tty_)
+          std::fprintf(stderr, "stage %d: %zu negatives found in %zu windows (cascade false-alarm rate %.3g)\n",
+                       e.stage, e.negatives, e.windowsScanned, e.cascadeFalseAlarm);
+        else
+          status(e, "bootstrapping");
+        break;
+      case ProgressKind::kStageStart:
+        positives_ = e.positives;
+        if (tty_) status(e, "evaluating the pool");
+        break;
+      case ProgressKind::kRound:
+        if (tty_) status(e, "");
+        else if (e.round % 10 == 0)
+          std::fprintf(stderr, "stage %d round %d: hit rate %.4f, false alarms %.4f, %s elapsed\n", e.stage,
+                       e.round, e.hitRate, e.falseAlarm, clock(e.elapsedSeconds).c_str());
+        break;
+    }
+  }
+
+ private:
+  void line(const std::string& text) {
+    if (tty_) std::fprintf(stderr, "\r\033[K");
+    std::fprintf(stderr, "%s\n", text.c_str());
+  }
+  std::string eta(const boosting::ProgressEvent& e) const {
+    if (stageSeconds_.empty()) return "?";
+    double mean = 0;
+    for (double s : stageSeconds_) mean += s;
+    mean /= double(stageSeconds_.size());
+    const double fa = std::max(cascadeFa_ * maxFa_, 1e-300);
+    double more = fa <= targetFa_ ? 0 : std::ceil(std::log(targetFa_ / fa) / std::log(maxFa_));
+    more = std::min(more, double(e.maxStages - e.stage));
+    const double inStage = std::max(0.0, mean - (e.elapsedSeconds - stageStart_));
+    return "~" + clock(inStage + more * mean);
+  }
+  void status(const boosting::ProgressEvent& e, const char* phase) {
+    std::fprintf(stderr,
+                 "\r\033[Kstage %d/%d  round %d/%d  hit %.4f  false alarms %.4f  positives %zu  negatives %zu "
+                 "(of %zu windows)  %s  elapsed %s  ETA %s",
+                 e.stage, e.maxStages, e.round, e.maxRounds, e.hitRate, e.falseAlarm, positives_, found_, scanned_,
+                 phase, clock(e.elapsedSeconds).c_str(), eta(e).c_str());
+    std::fflush(stderr);
+  }
+
+  bool tty_;
+  double maxFa_, targetFa_;
+  std::vector<double> stageSeconds_;
+  double stageStart_ = 0, cascadeFa_ = 1;
+  std::size_t found_ = 0, scanned_ = 0, positives_ = 0;
+};
+
+int runTrain(const TrainOptions& o) {
+  boosting::TrainingConfig c;
+  c.className = o.className;
+  c.pool.layers = splitList(o.layers);
+  c.pool.types = boosting::parseFeatureTypes(o.types);
+  c.pool.grid = o.grid;
+  c.pool.positionStep = o.positionStep;
+  c.pool.sizeStep = o.sizeStep;
+  c.pool.minCellSize = o.minCell;
+  c.samples.baseWindowHeight = o.windowHeight;
+  c.samples.minPositiveHeight = o.minHeight;
+  c.samples.maxOcclusion = o.maxOcclusion;
+  c.samples.flipPositives = !o.noFlip;
+  c.samples.scan.scaleFactor = o.scaleFactor;
+  c.samples.scan.step = o.step;
+  c.stage.minHit = o.minHit;
+  c.stage.maxFalseAlarm = o.maxFa;
+  c.stage.maxWeak = o.rounds;
+  c.targetFalseAlarm = o.targetFa;
+  c.maxStages = o.stages;
+  c.negativesPerStage = o.negatives;
+  c.seed = o.seed;
+  c.threads = o.threads;
+  c.validate();
+  if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
+
+  // Train/test split per group, in manifest (frame) order.
+  const auto entries = readDatasetManifest(o.data);
+  const std::set<std::string> groups(o.groups.begin(), o.groups.end()),
+      trainOnly(o.trainOnly.begin(), o.trainOnly.end());
+  std::map<std::string, std::vector<std::string>> byGroup;
+  std::vector<std::string> order;
+  for (const auto& e : entries) {
+    if (!groups.empty() && !groups.count(e.group) && !trainOnly.count(e.group)) continue;
+    if (!byGroup.count(e.group)) order.push_back(e.group);
+    byGroup[e.group].push_back(e.id);
+  }
+  for (const auto& g : o.groups)
+    if (!byGroup.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
+  for (const auto& g : o.trainOnly)
+    if (!byGroup.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
+  std::vector<std::string> trainIds, testIds;
+  for (const auto& g : order) {
+    const auto& ids = byGroup[g];
+    const std::size_t n = trainOnly.count(g) ? ids.size()
+                                              : static_cast<std::size_t>(std::lround(double(ids.size()) * o.split));
+    trainIds.insert(trainIds.end(), ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n));
+    testIds.insert(testIds.end(), ids.begin() + static_cast<std::ptrdiff_t>(n), ids.end());
+    std::fprintf(stderr, "group %s: %zu items, %zu train, %zu held back\n", g.c_str(), ids.size(), n,
+                 ids.size() - n);
+  }
+  if (trainIds.empty()) throw std::runtime_error(o.data.string() + ": no training items selected");
+  if (!o.testList.empty()) {
+    std::ofstream out(o.testList);
+    for (const auto& id : testIds) out << id << "\n";
+    if (!out) throw std::runtime_error(o.testList.string() + ": cannot write");
+  }
+
+  // Layers to load: hue_distance is derived from hue.
+  std::vector<std::string> load;
+  for (const auto& l : c.pool.layers) {
+    const std::string need = l == "hue_distance" ? "hue" : l;
+    if (std::find(load.begin(), load.end(), need) == load.end()) load.push_back(need);
+  }
+  std::vector<DatasetItem> items;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const auto& id : trainIds) items.push_back(readDatasetItem(o.data, id, load));
+  std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+
+  const bool tty = o.progress == "tty" || (o.progress == "auto" && isatty(STDERR_FILENO));
+  ConsoleProgress progress(tty, o.maxFa, o.targetFa);
+  boosting::TrainingReport report;
+  const boosting::Cascade cascade = boosting::trainCascade(c, items, progress, &report);
+
+  const std::filesystem::path out = o.out.empty() ? std::filesystem::path(o.className + ".json") : o.out;
+  boosting::ModelInfo info = {
+      {"data", o.data.filename().string()},
+      {"train_items", std::to_string(trainIds.size())},
+      {"layers", o.layers},
+      {"types", o.types},
+      {"grid", std::to_string(o.grid)},
+      {"pool_size", std::to_string(report.poolSize)},
+      {"positives", std::to_string(report.positives)},
+      {"seed", std::to_string(o.seed)},
+      {"min_hit", std::to_string(o.minHit)},
+      {"max_fa", std::to_string(o.maxFa)},
+      {"stop_reason", report.stopReason},
+  };
+  boosting::saveModel(cascade, out, info);
+  std::printf("wrote %s: class %s, %zu stages, %zu stumps, window %dx%d, training %.1f s\n", out.string().c_str(),
+              cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), cascade.windowWidth,
+              cascade.windowHeight, report.seconds);
+  std::printf("stop: %s\n", report.stopReason.c_str());
+  return 0;
+}
+
+const bool registered = registerCommand(
+    "train",
+    "Train a boosted cascade for one class on a data set (Gentle AdaBoost, joint feature pool)",
+    [](CLI::App& app) {
+      auto o = std::make_shared<TrainOptions>();
+      app.add_option("--data", o->data, "data set directory (docs/dataset-format.md), e.g. from import-kitti")
+          ->required();
+      app.add_option("-o,--out", o->out, "model file to write (JSON, boost/model_io.h); default: <class>.json");
+      app.add_option("--class", o->className,
+                     "class to train: labels of this class are positives, every other label and the "
+                     "background are negatives (e.g. KITTI vans for car), ignore regions are skipped")
+          ->capture_default_str();
+      app.add_option("--layers", o->layers,
+                     "comma-separated layers of the joint feature pool; hue_distance is derived from hue "
+                     "with the class's reference hue (computed from the positives and stored in the model)")
+          ->capture_default_str();
+      app.add_option("--types", o->types,
+                     "feature types of the pool: letters a-j (paper Fig. 1) and ranges, e.g. a-f (no corner "
+                     "features), g-j, or all")
+          ->capture_default_str();
+      app.add_option("--grid", o->grid, "grid units per side of the unit square the pool is laid on")
+          ->capture_default_str();
+      app.add_option("--position-step", o->positionStep, "feature positions every n grid units")
+          ->capture_default_str();
+      app.add_option("--size-step", o->sizeStep, "feature cell sizes every n grid units")->capture_default_str();
+      app.add_option("--min-cell", o->minCell, "smallest feature cell in grid units")->capture_default_str();
+      app.add_option("--window-height", o->windowHeight,
+                     "model window height in pixels (smallest object scanned); the width follows the "
+                     "median aspect ratio of the positives")
+          ->capture_default_str();
+      app.add_option("--min-hit", o->minHit, "hit rate every stage keeps on its positives")->capture_default_str();
+      app.add_option("--max-fa", o->maxFa, "false-alarm rate at which a stage is complete")->capture_default_str();
+      app.add_option("--target-fa", o->targetFa,
+                     "stop when the cascade accepts at most this share of the label-free windows")
+          ->capture_default_str();
+      app.add_option("--stages", o->stages, "stage limit")->capture_default_str();
+      app.add_option("--rounds", o->rounds, "boosting rounds (stumps) per stage at most")->capture_default_str();
+      app.add_option("--negatives", o->negatives, "negatives per stage (0 = max(500, 2 x positives))")
+          ->capture_default_str();
+      app.add_option("--min-height", o->minHeight, "[px] smaller labels of the class are not used as positives")
+          ->capture_default_str();
+      app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
+          ->capture_default_str();
+      app.add_flag("--no-flip", o->noFlip, "do not add horizontally mirrored positives");
+      app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
+          ->capture_default_str();
+      app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")
+          ->capture_default_str();
+      app.add_option("--seed", o->seed, "seed of the negative sampling (same seed + data = same model file)")
+          ->capture_default_str();
+      app.add_option("--threads", o->threads, "worker threads (0 = all cores)")->capture_default_str();
+      app.add_option("--split", o->split,
+                     "share of each group's items (in frame order) used for training; the rest is held back")
+          ->capture_default_str();
+      app.add_option("--groups", o->groups, "only these groups (default: all); repeatable")->delimiter(',');
+      app.add_option("--train-only", o->trainOnly,
+                     "groups used entirely for training (no held-back part); repeatable")
+          ->delimiter(',');
+      app.add_option("--test-list", o->testList, "write the held-back item ids to this file, one per line");
+      app.add_option("--progress", o->progress, "auto (status line on a terminal), tty or log")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"auto", "tty", "log"}));
+      app.footer(
+          "Per stage: positives the cascade still accepts; negatives bootstrapped from label-free windows\n"
+          "(IoU < 0.3 with every label of the class, not inside ignore regions) that the cascade still\n"
+          "accepts; the pool evaluated once and binned; Gentle AdaBoost rounds until the stage's false\n"
+          "alarms <= --max-fa at hit rate >= --min-hit. Training ends at --target-fa, at --stages, or when\n"
+          "no negatives are left; the last line says which, with the numbers.\n\n"
+          "Examples:\n"
+          "  fusedet import-kitti --out ds\n"
+          "  fusedet train --data ds --class car --out car.json\n"
+          "  fusedet train --data ds --class car --layers intensity,hue_distance --types a-f --grid 12\n"
+          "  fusedet train --data ds --groups kitti --train-only kitti_0009 --test-list test.txt");
+      return [o] { return runTrain(*o); };
+    });
+
+}  // namespace
+}  // namespace fusedet::tools
