@@ -3,6 +3,7 @@
 #include "opencv_pyramid.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -145,7 +146,7 @@ void forEachRow(std::size_t rows, int threads, const Body& body) {
     });
   };
   if (threads > 1) {
-    tbb::task_arena arena(threads);
+    tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
     arena.execute(run);
   } else {
     run();

@@ -3,6 +3,7 @@
 #include "fusedet/boost/opencv_cascade.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/info.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -458,7 +459,7 @@ std::vector<RawHit> scanOpenCvPyramid(const Cascade& c, const LayerStack& stack,
         });
       };
       if (params.threads > 1) {
-        tbb::task_arena arena(params.threads);
+        tbb::task_arena arena(std::min(params.threads, tbb::info::default_concurrency()));
         arena.execute(run);
       } else {
         run();
