@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -344,6 +345,31 @@ TEST_F(LmsSim, VanishAndReappearRecoversWithinTwoSeconds) {
   EXPECT_TRUE(stream.stop());
   EXPECT_EQ(sim_->state().baud, 9600);
   EXPECT_FALSE(sim_->state().streaming);
+}
+
+TEST_F(LmsSim, DeviceRestartIsNoticedAndFullyReinitialised) {
+  sim::SimOptions o;
+  startSim(o);
+  std::atomic<int> scans{0};
+  ScanStream stream(config(500000, {180, 100}), [&](const LaserScan&) { ++scans; }, 5000ms, 500ms);
+  stream.start();
+  const auto waitFor = [&](int n) {
+    const auto end = Clock::now() + 5s;
+    while (scans < n && Clock::now() < end) std::this_thread::sleep_for(5ms);
+    return scans >= n;
+  };
+  ASSERT_TRUE(waitFor(10));
+  sim_->powerCycle();  // back at 9600 in monitoring mode: the host at 500k hears nothing
+  const auto restarted = Clock::now();
+  const int before = scans;
+  ASSERT_TRUE(waitFor(before + 5));
+  const double recovery = std::chrono::duration<double>(Clock::now() - restarted).count();
+  std::printf("device restart: streaming again after %.3f s (silence limit 0.5 s)\n", recovery);
+  EXPECT_LT(recovery, 2.5);
+  EXPECT_EQ(stream.counters().reconnects, 1u);
+  EXPECT_EQ(sim_->state().baud, 500000);
+  EXPECT_TRUE(stream.stop());
+  EXPECT_EQ(sim_->state().baud, 9600);
 }
 
 TEST_F(LmsSim, SilenceTimesOutThenStreamingResumes) {

@@ -155,6 +155,10 @@ void Simulator::silence(std::chrono::milliseconds d) {
   std::lock_guard lock(mutex_);
   silentUntil_ = Clock::now() + d;
 }
+void Simulator::powerCycle() {
+  std::lock_guard lock(mutex_);
+  powerOn();
+}
 void Simulator::vanish(std::chrono::milliseconds d) {
   std::lock_guard lock(mutex_);
   vanishRequest_ = d;

@@ -109,6 +109,7 @@ class Simulator {
   void nakStorm(int requests);                    // the next `requests` valid requests get NAK
   void silence(std::chrono::milliseconds d);      // neither reads nor writes for d
   void vanish(std::chrono::milliseconds d);       // pty gone for d, then power-on again
+  void powerCycle();                              // the device restarts; the pty stays (9600, monitoring)
   // Numbers (see SimOptions::counterBeam) of the scans that went out damaged, in order.
   std::vector<std::uint64_t> damagedScans() const;
   std::vector<std::uint64_t> crcBlindScans() const;  // damaged but with a matching CRC
