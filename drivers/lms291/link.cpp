@@ -21,6 +21,7 @@ Result<void> Link::open(const std::string& path, int baud) {
   if (!port) return port.error();
   port_ = std::move(*port);
   reader_.clear();
+  reader_.setByteTime(static_cast<std::int64_t>(byteSeconds(baud) * 1e9));
   if (forceTermios2_) return port_.setBaud(baud, true);
   return {};
 }
@@ -33,6 +34,7 @@ void Link::close() {
 Result<void> Link::setBaud(int baud) {
   auto r = port_.setBaud(baud, forceTermios2_);
   reader_.clear();
+  reader_.setByteTime(static_cast<std::int64_t>(byteSeconds(baud) * 1e9));
   port_.flushInput();
   return r;
 }
@@ -56,6 +58,7 @@ Result<std::optional<StreamEvent>> Link::nextEvent(Clock::time_point deadline) {
   std::array<std::uint8_t, 4096> buffer{};
   for (;;) {
     if (auto e = reader_.next()) return std::optional<StreamEvent>(std::move(*e));
+    if (cancel_ && cancel_->load()) return makeError(std::errc::operation_canceled, "cancelled");
     const auto now = Clock::now();
     if (now >= deadline) return std::optional<StreamEvent>();
     const auto wait = std::min<std::chrono::microseconds>(

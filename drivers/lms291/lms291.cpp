@@ -64,7 +64,7 @@ RequestOptions Lms291::options(std::chrono::milliseconds replyTimeout) const {
       static_cast<std::int64_t>(byteSeconds(std::max(link_.baud(), 1)) * kMaxTelegramSize * 1000) + 1);
   if (streaming_) o.ackTimeout += lineTime;
   o.replyTimeout = replyTimeout + lineTime;
-  o.retries = config_.retries;
+  o.retries = stopping_ ? std::min(config_.retries, 1) : config_.retries;
   return o;
 }
 
@@ -239,6 +239,12 @@ Result<DeviceInfo> Lms291::start() {
 
 Result<void> Lms291::stop() {
   if (!link_.isOpen()) return {};
+  // Best effort and bounded: a device that does not answer must not hold up a shutdown.
+  stopping_ = true;
+  struct Reset {
+    bool& flag;
+    ~Reset() { flag = false; }
+  } reset{stopping_};
   Result<void> first;
   if (auto r = setMode(Mode::kMonitoring); !r) first = r;
   if (auto r = switchBaud(9600); !r && first) first = r;

@@ -16,17 +16,21 @@ std::string_view toString(StreamState s) {
 
 ScanStream::ScanStream(Lms291Config config, ScanHandler onScan, std::chrono::milliseconds reconnectMax,
                        std::chrono::milliseconds silenceLimit)
-    : device_(std::move(config)), onScan_(std::move(onScan)), reconnectMax_(reconnectMax), silenceLimit_(silenceLimit) {}
+    : device_(std::move(config)), onScan_(std::move(onScan)), reconnectMax_(reconnectMax), silenceLimit_(silenceLimit) {
+  device_.link().setCancelFlag(&cancel_);
+}
 
 ScanStream::~ScanStream() { (void)stop(); }
 
 void ScanStream::start() {
   if (running_.exchange(true)) return;
+  cancel_ = false;
   thread_ = std::thread([this] { run(); });
 }
 
 Result<void> ScanStream::stop() {
   if (!running_.exchange(false)) return {};
+  cancel_ = true;
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
   std::lock_guard lock(mutex_);
@@ -53,6 +57,7 @@ void ScanStream::run() {
   while (running_) {
     state_ = StreamState::kConnecting;
     auto info = device_.start();
+    if (!info && !running_) break;  // cancelled: stop() below still returns the device to 9600
     if (!info) {
       device_.close();
       {
@@ -99,6 +104,7 @@ void ScanStream::run() {
     state_ = StreamState::kBackingOff;
     if (!sleepFor(backoff)) break;
   }
+  cancel_ = false;  // the stop sequence itself must run
   Result<void> r = device_.stop();
   std::lock_guard lock(mutex_);
   counters_.device = device_.counters();

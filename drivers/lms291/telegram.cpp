@@ -44,11 +44,22 @@ void TelegramReader::feed(std::span<const std::uint8_t> bytes, Stamp received) {
   buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
   counters_.bytes += bytes.size();
   lastFeed_ = received;
+  if (!bytes.empty()) chunks_.emplace_back(bufferOffset_ + buffer_.size(), received);
+}
+
+Stamp TelegramReader::arrival(std::size_t endOffset) {
+  // Chunks wholly before the buffer are history; keep the rest (a failed long frame may look
+  // ahead, then a shorter real one follows).
+  while (!chunks_.empty() && chunks_.front().first <= bufferOffset_) chunks_.pop_front();
+  for (const auto& [chunkEnd, stamp] : chunks_)
+    if (chunkEnd >= endOffset) return stamp - static_cast<std::int64_t>(chunkEnd - endOffset) * byteNs_;
+  return lastFeed_;
 }
 
 void TelegramReader::clear() {
   bufferOffset_ += buffer_.size();
   buffer_.clear();
+  chunks_.clear();
   inGarbage_ = false;
   releaseLone_ = false;
 }
@@ -115,7 +126,7 @@ std::optional<StreamEvent> TelegramReader::next() {
 
     StreamEvent e;
     e.offset = bufferOffset_;
-    e.received = lastFeed_;
+    e.received = arrival(bufferOffset_ + frameSize);
     Telegram& t = e.telegram;
     t.address = raw[1];
     t.command = raw[4];
@@ -123,7 +134,7 @@ std::optional<StreamEvent> TelegramReader::next() {
     const std::size_t dataEnd = frameSize - 2 - (hasStatus ? 1 : 0);
     t.data.assign(raw.begin() + 5, raw.begin() + static_cast<std::ptrdiff_t>(dataEnd));
     if (hasStatus) t.status = raw[frameSize - 3];
-    t.received = lastFeed_;
+    t.received = e.received;
     t.offset = bufferOffset_;
     e.raw = std::move(raw);
     if (ok) {

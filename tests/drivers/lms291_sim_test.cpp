@@ -378,15 +378,36 @@ TEST_F(LmsSim, SilenceTimesOutThenStreamingResumes) {
   Lms291 lms(config(500000, {180, 100}));
   ASSERT_TRUE(lms.start());
   ASSERT_TRUE(lms.readScan(1000ms));
-  sim_->silence(400ms);
-  std::this_thread::sleep_for(20ms);
-  (void)lms.readScan(0ms);
-  auto s = lms.readScan(200ms);
-  ASSERT_FALSE(s);
-  EXPECT_EQ(s.error().code, std::errc::timed_out);
-  EXPECT_TRUE(lms.readScan(1000ms));
+  sim_->silence(600ms);
+  // At most the scan already on the line arrives; then nothing.
+  bool timedOut = false;
+  for (int i = 0; i < 3 && !timedOut; ++i) {
+    auto s = lms.readScan(150ms);
+    if (!s) {
+      EXPECT_EQ(s.error().code, std::errc::timed_out);
+      timedOut = true;
+    }
+  }
+  EXPECT_TRUE(timedOut);
+  EXPECT_TRUE(lms.readScan(1500ms));
   EXPECT_GE(lms.counters().link.timeouts, 1u);
   EXPECT_TRUE(lms.stop());
+}
+
+TEST_F(LmsSim, StopDuringASlowInitIsPrompt) {
+  sim::SimOptions o;
+  startSim(o);
+  sim_->silence(10s);  // the device answers nothing: the init probes every speed
+  ScanStream stream(config(38400), [](const LaserScan&) {});
+  stream.start();
+  std::this_thread::sleep_for(300ms);
+  const auto t0 = Clock::now();
+  (void)stream.stop();
+  const double took = std::chrono::duration<double>(Clock::now() - t0).count();
+  // The init is cut short at once; the stop sequence (streaming off, 9600) then gives up on the
+  // silent device after one retry of 100 ms each.
+  EXPECT_LT(took, 0.6) << "stop() waited for the init";
+  EXPECT_EQ(stream.state(), StreamState::kStopped);
 }
 
 TEST_F(LmsSim, InterlacedPartialScansAreMerged) {
@@ -484,7 +505,7 @@ TEST_F(LmsSim, BytesAtTheWrongSpeedAreIgnoredAndScanStampsAccountForLineTime) {
     ASSERT_TRUE(s);
     const double ageMs = double(fusedet::Stamp::now() - s->stamp) * 1e-6;
     EXPECT_GE(ageMs, 372 * 10.0 / 38400 * 1000);
-    EXPECT_LT(ageMs, 372 * 10.0 / 38400 * 1000 + 50);
+    EXPECT_LT(ageMs, 372 * 10.0 / 38400 * 1000 + 300);  // loose: the test thread may be descheduled
   }
   EXPECT_TRUE(lms.stop());
 }

@@ -137,6 +137,23 @@ TEST(LmsTelegram, ReplyAfterAckAsFusSendsIt) {
   EXPECT_FALSE(reader.next());
 }
 
+TEST(LmsTelegram, TelegramsEndingInsideAChunkAreStampedByLineTime) {
+  const Bytes reply{0x02, 0x80, 0x03, 0x00, 0xA0, 0x00, 0x10, 0x16, 0x0A};
+  TelegramReader reader;
+  reader.setByteTime(20'000);  // 500 kbaud: 20 us per byte
+  reader.feed(cat(reply, reply), fusedet::Stamp{1'000'000'000});
+  auto first = reader.next();
+  auto second = reader.next();
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(first->telegram.received.ns, 1'000'000'000 - 9 * 20'000);  // 9 bytes followed it
+  EXPECT_EQ(second->telegram.received.ns, 1'000'000'000);
+  reader.feed(Bytes(reply.begin(), reply.begin() + 4), fusedet::Stamp{2'000'000'000});
+  reader.feed(Bytes(reply.begin() + 4, reply.end()), fusedet::Stamp{3'000'000'000});
+  auto split = reader.next();
+  ASSERT_TRUE(split);
+  EXPECT_EQ(split->telegram.received.ns, 3'000'000'000);
+}
+
 TEST(LmsTelegram, PowerOnTelegramText) {
   TelegramReader reader;
   reader.feed(cat(cat(cat({0x02, 0x81, 0x17, 0x00, 0x90}, "LMS200;301063;V02.06 "), Bytes{0x13}), Bytes{0x64, 0x5A}));

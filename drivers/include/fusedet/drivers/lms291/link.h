@@ -3,6 +3,7 @@
 // waits for the lone ACK (NAK => wait 30 ms and resend), then for the reply (request | 0x80),
 // retrying on silence; while waiting, streamed telegrams are passed over and counted.
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -50,6 +51,9 @@ class Link {
   // Next valid device telegram; timed_out when none completes within `timeout`.
   Result<Telegram> receive(std::chrono::microseconds timeout);
 
+  // While *cancel is true every wait ends at once with operation_canceled (prompt shutdown).
+  void setCancelFlag(const std::atomic<bool>* cancel) { cancel_ = cancel; }
+
   // Sees every raw chunk read from the port (recording hook).
   void setRawHook(std::function<void(std::span<const std::uint8_t>, Stamp)> hook) { rawHook_ = std::move(hook); }
 
@@ -63,6 +67,7 @@ class Link {
   TelegramReader reader_{Direction::kFromDevice};
   LinkCounters counters_;
   bool forceTermios2_ = false;
+  const std::atomic<bool>* cancel_ = nullptr;
   std::function<void(std::span<const std::uint8_t>, Stamp)> rawHook_;
 };
 

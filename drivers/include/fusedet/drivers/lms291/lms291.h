@@ -99,6 +99,7 @@ class Lms291 {
   std::uint8_t activeMeasuringMode_ = kMeasuring8m;
   Unit activeUnit_ = Unit::kMm;
   bool streaming_ = false;
+  bool stopping_ = false;  // stop(): fewer retries
   std::optional<std::uint8_t> lastTelegramIndex_;
   std::uint64_t sequence_ = 0;
   StatusByte lastStatus_;

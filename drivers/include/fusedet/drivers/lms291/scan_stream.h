@@ -54,6 +54,7 @@ class ScanStream {
   std::chrono::milliseconds silenceLimit_;
   std::atomic<StreamState> state_{StreamState::kStopped};
   std::atomic<bool> running_{false};
+  std::atomic<bool> cancel_{false};  // ends the device's waits (e.g. a slow init) on stop()
   std::thread thread_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -83,7 +83,11 @@ class TelegramReader {
  public:
   explicit TelegramReader(Direction direction = Direction::kFromDevice) : direction_(direction) {}
 
+  // `received`: when the chunk was read, i.e. when its last byte had arrived.
   void feed(std::span<const std::uint8_t> bytes, Stamp received = Stamp::now());
+  // Line time of one byte: a telegram that ends inside a chunk is stamped that much earlier
+  // per byte that followed it in the chunk (0 = stamp with the chunk's time).
+  void setByteTime(std::int64_t ns) { byteNs_ = ns; }
   // Next event, or nothing when more bytes are needed.
   std::optional<StreamEvent> next();
   // After a silence: give up a frame that waits for bytes that will not come (e.g. a garbage
@@ -100,11 +104,14 @@ class TelegramReader {
  private:
   bool plausibleHeader(std::size_t at, std::size_t* frameSize) const;
   void skip(std::size_t n);
+  Stamp arrival(std::size_t endOffset);  // when the byte before stream offset endOffset arrived
 
   Direction direction_;
   std::deque<std::uint8_t> buffer_;
   std::size_t bufferOffset_ = 0;  // stream offset of buffer_[0]
   Stamp lastFeed_;
+  std::deque<std::pair<std::size_t, Stamp>> chunks_;  // (stream offset after the chunk, read time)
+  std::int64_t byteNs_ = 0;
   bool inGarbage_ = false;
   bool releaseLone_ = false;  // a trailing ACK/NAK byte was followed by silence
   ReaderCounters counters_;
