@@ -8,8 +8,11 @@ namespace fusedet::boosting {
 std::size_t Cascade::weakCount() const {
   std::size_t n = 0;
   for (const Stage& s : stages) n += s.stumps.size();
+  for (const auto& t : treeStages) n += t.size();
   return n;
 }
+
+bool Cascade::hasTrees() const { return !treeStages.empty(); }
 
 int Cascade::addFeature(const Feature& f) {
   features.push_back(f);
@@ -57,19 +60,51 @@ void Cascade::validate() const {
       if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
     }
   }
+  const bool trees = hasTrees();
+  if (trees && !isOpenCv()) fail("decision trees are only supported in imported OpenCV cascades");
+  if (trees && treeStages.size() != stages.size())
+    fail("tree cascade has " + std::to_string(treeStages.size()) + " tree stages for " + std::to_string(stages.size()) +
+         " stages");
   for (std::size_t s = 0; s < stages.size(); ++s) {
     const Stage& st = stages[s];
     const std::string at = "stage " + std::to_string(s);
-    if (st.stumps.empty()) fail(at + " has no weak classifiers");
+    const std::vector<Tree> noTrees;
+    const std::vector<Tree>& stTrees = trees ? treeStages[s] : noTrees;
+    if (st.stumps.empty() && stTrees.empty()) fail(at + " has no weak classifiers");
+    if (trees && !st.stumps.empty()) fail(at + " mixes stumps and trees");
     if (!std::isfinite(st.threshold)) fail(at + " threshold is not finite");
+    auto checkFeature = [&](int feature, const std::string& atk) {
+      if (feature < 0 || static_cast<std::size_t>(feature) >= nFeatures)
+        fail(atk + ": feature index " + std::to_string(feature) + " out of range (model has " +
+             std::to_string(nFeatures) + " features)");
+    };
     for (std::size_t k = 0; k < st.stumps.size(); ++k) {
       const Stump& t = st.stumps[k];
       const std::string atk = at + " weak classifier " + std::to_string(k);
-      if (t.feature < 0 || static_cast<std::size_t>(t.feature) >= nFeatures)
-        fail(atk + ": feature index " + std::to_string(t.feature) + " out of range (model has " +
-             std::to_string(nFeatures) + " features)");
+      checkFeature(t.feature, atk);
       if (!std::isfinite(t.threshold)) fail(atk + ": threshold is not finite");
       if (!std::isfinite(t.left) || !std::isfinite(t.right)) fail(atk + ": leaf value is not finite");
+    }
+    for (std::size_t k = 0; k < stTrees.size(); ++k) {
+      const Tree& t = stTrees[k];
+      const std::string atk = at + " weak classifier " + std::to_string(k);
+      if (t.nodes.empty()) fail(atk + ": tree without nodes");
+      if (t.leaves.size() != t.nodes.size() + 1) fail(atk + ": tree needs nodes + 1 leaves");
+      for (double v : t.leaves)
+        if (!std::isfinite(v)) fail(atk + ": leaf value is not finite");
+      for (std::size_t n = 0; n < t.nodes.size(); ++n) {
+        const TreeNode& node = t.nodes[n];
+        checkFeature(node.feature, atk);
+        if (!std::isfinite(node.threshold)) fail(atk + ": threshold is not finite");
+        for (int child : {node.left, node.right}) {
+          // Children after their parent: evaluation always terminates.
+          const bool okNode = child > 0 && static_cast<std::size_t>(child) > n && static_cast<std::size_t>(child) < t.nodes.size();
+          const bool okLeaf = child <= 0 && static_cast<std::size_t>(-static_cast<long long>(child)) < t.leaves.size();
+          if (!okNode && !okLeaf)
+            fail(atk + ": node " + std::to_string(n) + " has child " + std::to_string(child) +
+                 " (must be a later node or a leaf)");
+        }
+      }
     }
   }
 }

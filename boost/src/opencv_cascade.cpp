@@ -149,6 +149,7 @@ class Importer {
     for (std::size_t s = 0; s < stageItems.size(); ++s) {
       const Element& se = *stageItems[s];
       Stage stage;
+      std::vector<Tree> trees;
       stage.threshold = stageThreshold(number(need(se, "stageThreshold")));
       const auto weaks = items(need(se, "weakClassifiers"));
       if (const Element* mw = se.child("maxWeakCount"); mw && integer(*mw) != int(weaks.size()))
@@ -163,24 +164,39 @@ class Importer {
         if (leaves.size() != nodes.size() / 4 + 1)
           fail(*w, "weak classifier has " + std::to_string(nodes.size() / 4) + " nodes but " +
                        std::to_string(leaves.size()) + " leaf values (expected nodes + 1)");
-        if (nodes.size() != 4)
-          fail(nodesEl, "weak classifier is a tree of " + std::to_string(nodes.size() / 4) +
-                            " splits; only stumps (one split) are supported");
-        if (integer(nodesEl, nodes[0]) != 0 || integer(nodesEl, nodes[1]) != -1)
-          fail(nodesEl, "stump must have leaves 0 and -1 as children");
-        const int fi = integer(nodesEl, nodes[2]);
-        if (fi < 0) fail(nodesEl, "negative feature index");
-        stage.stumps.push_back(Stump{fi, double(static_cast<float>(nodes[3])), leaf(leaves[0]), leaf(leaves[1])});
+        Tree t;
+        for (std::size_t n = 0; n < nodes.size(); n += 4) {
+          const int fi = integer(nodesEl, nodes[n + 2]);
+          if (fi < 0) fail(nodesEl, "negative feature index");
+          t.nodes.push_back(TreeNode{fi, double(static_cast<float>(nodes[n + 3])), integer(nodesEl, nodes[n]),
+                                     integer(nodesEl, nodes[n + 1])});
+        }
+        for (double v : leaves) t.leaves.push_back(leaf(v));
+        trees.push_back(std::move(t));
       }
+      out.treeStages.push_back(std::move(trees));
       out.stages.push_back(std::move(stage));
     }
     const auto feats = items(need(c, "features"));
     for (const Element* f : feats) out.haarFeatures.push_back(feature(*f));
-    for (std::size_t s = 0; s < out.stages.size(); ++s)
-      for (const Stump& t : out.stages[s].stumps)
-        if (static_cast<std::size_t>(t.feature) >= out.haarFeatures.size())
-          fail(c, "stage " + std::to_string(s) + " uses feature " + std::to_string(t.feature) + " but <features> holds " +
-                      std::to_string(out.haarFeatures.size()));
+    for (std::size_t s = 0; s < out.treeStages.size(); ++s)
+      for (const Tree& t : out.treeStages[s])
+        for (const TreeNode& n : t.nodes)
+          if (static_cast<std::size_t>(n.feature) >= out.haarFeatures.size())
+            fail(c, "stage " + std::to_string(s) + " uses feature " + std::to_string(n.feature) +
+                        " but <features> holds " + std::to_string(out.haarFeatures.size()));
+    toStumpsIfPossible(out);
+  }
+
+  // Cascades of one-split trees (leaves 0 and 1 as children) become stumps: the fast path.
+  static void toStumpsIfPossible(Cascade& c) {
+    for (const auto& st : c.treeStages)
+      for (const Tree& t : st)
+        if (t.nodes.size() != 1 || t.nodes[0].left != 0 || t.nodes[0].right != -1) return;
+    for (std::size_t s = 0; s < c.treeStages.size(); ++s)
+      for (const Tree& t : c.treeStages[s])
+        c.stages[s].stumps.push_back(Stump{t.nodes[0].feature, t.nodes[0].threshold, t.leaves[0], t.leaves[1]});
+    c.treeStages.clear();
   }
 
   void readOld(const Element& c, Cascade& out) const {
@@ -193,21 +209,36 @@ class Importer {
       fail(size, "window size out of range");
     for (const Element* se : items(need(c, "stages"))) {
       Stage stage;
+      std::vector<Tree> trees;
       stage.threshold = stageThreshold(number(need(*se, "stage_threshold")));
       for (const Element* tree : items(need(*se, "trees"))) {
+        // OpenCV's converter: leaves are numbered in order of appearance, a leaf child is -index.
+        Tree t;
         const auto nodes = items(*tree);
-        if (nodes.size() != 1)
-          fail(*tree, "tree has " + std::to_string(nodes.size()) + " nodes; only stumps (one split) are supported");
-        const Element& n = *nodes[0];
-        const Element* lv = n.child("left_val");
-        const Element* rv = n.child("right_val");
-        if (!lv || !rv) fail(n, "stump node needs <left_val> and <right_val>");
-        out.haarFeatures.push_back(feature(need(n, "feature")));
-        stage.stumps.push_back(Stump{int(out.haarFeatures.size()) - 1, double(static_cast<float>(number(need(n, "threshold")))),
-                                     leaf(number(*lv)), leaf(number(*rv))});
+        if (nodes.empty()) fail(*tree, "tree without nodes");
+        for (const Element* n : nodes) {
+          out.haarFeatures.push_back(feature(need(*n, "feature")));
+          TreeNode node{int(out.haarFeatures.size()) - 1, double(static_cast<float>(number(need(*n, "threshold")))), 0, 0};
+          auto child = [&](const char* val, const char* idx, int& to) {
+            if (const Element* v = n->child(val)) {
+              to = -static_cast<int>(t.leaves.size());
+              t.leaves.push_back(leaf(number(*v)));
+            } else if (const Element* i = n->child(idx)) {
+              to = integer(*i);
+            } else {
+              fail(*n, std::string("node needs <") + val + "> or <" + idx + ">");
+            }
+          };
+          child("left_val", "left_node", node.left);
+          child("right_val", "right_node", node.right);
+          t.nodes.push_back(node);
+        }
+        trees.push_back(std::move(t));
       }
+      out.treeStages.push_back(std::move(trees));
       out.stages.push_back(std::move(stage));
     }
+    toStumpsIfPossible(out);
   }
 
   static std::string trim(const std::string& s) {

@@ -40,8 +40,20 @@ struct CvStump {
 };
 
 struct CvStage {
-  std::uint32_t begin = 0, end = 0;
+  std::uint32_t begin = 0, end = 0;  // stumps, or trees for a tree cascade
   float threshold = 0;
+};
+
+// Tree cascades: nodes carry a feature each; children > 0 are node offsets, <= 0 leaves.
+struct CvNode {
+  std::array<std::array<std::int32_t, 4>, 3> ofs{};
+  std::array<float, 3> weight{};
+  int count = 2;
+  float threshold = 0;
+  int left = 0, right = 0;
+};
+struct CvTree {
+  std::uint32_t node = 0, leaf = 0;  // first node, first leaf
 };
 
 struct CvModel {
@@ -49,6 +61,10 @@ struct CvModel {
   std::vector<CvStump> stumps;
   std::vector<CvStage> stages;
   bool tilted = false;
+  bool trees = false;
+  std::vector<CvNode> nodes;
+  std::vector<CvTree> treeList;
+  std::vector<float> leaves;
   std::array<std::int32_t, 4> norm{};  // normrect corners (1, 1, w-2, h-2)
   double normArea = 0;
 };
@@ -61,26 +77,52 @@ CvModel compile(const Cascade& c, std::ptrdiff_t stride, std::ptrdiff_t tiltedOf
   auto at = [stride](int x, int y) { return static_cast<std::int32_t>(y * stride + x); };
   m.norm = {at(1, 1), at(m.winW - 1, 1), at(1, m.winH - 1), at(m.winW - 1, m.winH - 1)};
   m.normArea = double(m.winW - 2) * double(m.winH - 2);
-  for (const Stage& st : c.stages) {
+  // Rectangles of one feature as offsets (upright or tilted) and weights.
+  auto layout = [&](const HaarFeature& f, std::array<std::array<std::int32_t, 4>, 3>& ofs, std::array<float, 3>& w) {
+    for (int i = 0; i < f.count; ++i) {
+      const HaarRect& r = f.rects[static_cast<std::size_t>(i)];
+      auto& o = ofs[static_cast<std::size_t>(i)];
+      if (!f.tilted) {
+        o = {at(r.x, r.y), at(r.x + r.w, r.y), at(r.x, r.y + r.h), at(r.x + r.w, r.y + r.h)};
+      } else {
+        const auto t0 = static_cast<std::int32_t>(tiltedOffset);
+        o = {t0 + at(r.x, r.y), t0 + at(r.x - r.h, r.y + r.h), t0 + at(r.x + r.w, r.y + r.w),
+             t0 + at(r.x + r.w - r.h, r.y + r.w + r.h)};
+      }
+      w[static_cast<std::size_t>(i)] = r.weight;
+    }
+  };
+  m.trees = c.hasTrees();
+  for (std::size_t si = 0; si < c.stages.size(); ++si) {
+    const Stage& st = c.stages[si];
     CvStage cs;
-    cs.begin = static_cast<std::uint32_t>(m.stumps.size());
     cs.threshold = static_cast<float>(st.threshold);
+    if (m.trees) {
+      cs.begin = static_cast<std::uint32_t>(m.treeList.size());
+      for (const Tree& t : c.treeStages[si]) {
+        m.treeList.push_back(CvTree{static_cast<std::uint32_t>(m.nodes.size()), static_cast<std::uint32_t>(m.leaves.size())});
+        for (const TreeNode& n : t.nodes) {
+          const HaarFeature& f = c.haarFeatures[static_cast<std::size_t>(n.feature)];
+          CvNode z;
+          z.count = f.count;
+          layout(f, z.ofs, z.weight);
+          z.threshold = static_cast<float>(n.threshold);
+          z.left = n.left;
+          z.right = n.right;
+          m.nodes.push_back(z);
+        }
+        for (double v : t.leaves) m.leaves.push_back(static_cast<float>(v));
+      }
+      cs.end = static_cast<std::uint32_t>(m.treeList.size());
+      m.stages.push_back(cs);
+      continue;
+    }
+    cs.begin = static_cast<std::uint32_t>(m.stumps.size());
     for (const Stump& t : st.stumps) {
       const HaarFeature& f = c.haarFeatures[static_cast<std::size_t>(t.feature)];
       CvStump z;
       z.count = f.count;
-      for (int i = 0; i < f.count; ++i) {
-        const HaarRect& r = f.rects[static_cast<std::size_t>(i)];
-        auto& o = z.ofs[static_cast<std::size_t>(i)];
-        if (!f.tilted) {
-          o = {at(r.x, r.y), at(r.x + r.w, r.y), at(r.x, r.y + r.h), at(r.x + r.w, r.y + r.h)};
-        } else {
-          const auto t0 = static_cast<std::int32_t>(tiltedOffset);
-          o = {t0 + at(r.x, r.y), t0 + at(r.x - r.h, r.y + r.h), t0 + at(r.x + r.w, r.y + r.w),
-               t0 + at(r.x + r.w - r.h, r.y + r.w + r.h)};
-        }
-        z.weight[static_cast<std::size_t>(i)] = r.weight;
-      }
+      layout(f, z.ofs, z.weight);
       z.threshold = static_cast<float>(t.threshold);
       z.left = static_cast<float>(t.left);
       z.right = static_cast<float>(t.right);
@@ -110,9 +152,36 @@ inline bool normFactor(const CvModel& m, const std::int32_t* p, const std::uint3
   return m.normArea * vnf < 1e-1;
 }
 
+// Tree cascades (OpenCV's predictOrdered): walk each tree from its root to a leaf.
+int runTrees(const CvModel& m, const std::int32_t* p, float vnf, int first, double& score, std::size_t& weak) {
+  const int nStages = static_cast<int>(m.stages.size());
+  for (int s = first; s < nStages; ++s) {
+    const CvStage& st = m.stages[static_cast<std::size_t>(s)];
+    double sum = 0;
+    for (std::uint32_t k = st.begin; k < st.end; ++k) {
+      const CvTree& t = m.treeList[k];
+      int idx = 0;
+      do {
+        const CvNode& n = m.nodes[t.node + static_cast<std::uint32_t>(idx)];
+        float v = n.weight[0] * static_cast<float>(rectSum(p, n.ofs[0])) +
+                  n.weight[1] * static_cast<float>(rectSum(p, n.ofs[1]));
+        if (n.count == 3) v += n.weight[2] * static_cast<float>(rectSum(p, n.ofs[2]));
+        v *= vnf;
+        idx = v < n.threshold ? n.left : n.right;
+      } while (idx > 0);
+      sum += m.leaves[t.leaf + static_cast<std::uint32_t>(-idx)];
+    }
+    weak += st.end - st.begin;
+    score = sum;
+    if (sum < st.threshold) return -s;
+  }
+  return 1;
+}
+
 // Stages [first, end) of one window: -k = rejected by stage k, 1 = accepted (score = last sum).
 inline int runFrom(const CvModel& m, const std::int32_t* p, float vnf, int first, double& score,
                    std::size_t& stumps) {
+  if (m.trees) return runTrees(m, p, vnf, first, score, stumps);
   const CvStump* z = m.stumps.data();
   const int nStages = static_cast<int>(m.stages.size());
   for (int s = first; s < nStages; ++s) {
@@ -312,7 +381,7 @@ std::atomic<bool> gVectorEnabled{true};
 
 void scanRow(const RowJob& j, RowResult& out) {
 #ifdef FUSEDET_HAVE_AVX2_PATH
-  if (gVectorEnabled.load(std::memory_order_relaxed) && cpuHasAvx2()) {
+  if (!j.m->trees && gVectorEnabled.load(std::memory_order_relaxed) && cpuHasAvx2()) {
     if (j.step == 1) scanRowAvx2<1>(j, out);
     else scanRowAvx2<2>(j, out);
     return;

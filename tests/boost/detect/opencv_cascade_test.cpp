@@ -99,27 +99,20 @@ TEST(OpenCvCascade, ReadsEveryFieldWithOpenCvsLoadConventions) {
   EXPECT_FALSE(c.haarFeatures[1].tilted);
 }
 
-TEST(OpenCvCascade, LoadsEveryShippedStumpCascadeAndRejectsTreesClearly) {
-  int loaded = 0;
+TEST(OpenCvCascade, LoadsEveryShippedCascadeStumpsAndTrees) {
+  int loaded = 0, withTrees = 0;
   for (const auto& e : fs::directory_iterator(kCascades)) {
     const std::string name = e.path().filename().string();
     const bool trees = name.find("alt2") != std::string::npos || name.find("2splits") != std::string::npos ||
                        name.find("tree_eyeglasses") != std::string::npos;
-    if (trees) {
-      try {
-        loadOpenCvCascade(e.path());
-        ADD_FAILURE() << name << " has trees but loaded";
-      } catch (const std::runtime_error& err) {
-        EXPECT_NE(std::string(err.what()).find("only stumps"), std::string::npos) << err.what();
-        EXPECT_NE(std::string(err.what()).find(name), std::string::npos) << err.what();
-      }
-      continue;
-    }
     const Cascade c = loadOpenCvCascade(e.path());
     EXPECT_GT(c.stages.size(), 0u) << name;
+    EXPECT_EQ(c.hasTrees(), trees) << name;
+    withTrees += c.hasTrees();
     ++loaded;
   }
-  EXPECT_GE(loaded, 12);
+  EXPECT_EQ(withTrees, 4);
+  EXPECT_GE(loaded, 16);
   const Cascade face = loadOpenCvCascade(kCascades / "haarcascade_frontalface_default.xml");
   EXPECT_EQ(face.stages.size(), 25u);
   EXPECT_EQ(face.weakCount(), 2913u);
@@ -161,6 +154,27 @@ TEST(OpenCvCascade, WrongCountsAreReported) {
   expectError(replaced(kSmall, "<_>2 3 8 4 -1.</_><_>2 5 8 2 2.</_>", "<_>2 3 8 4 -1.</_>"), "1 rectangles");
   expectError(replaced(kSmall, "<_>2 3 8 4 -1.</_>", "<_>20 3 8 4 -1.</_>"), "outside the 24x20 window");
   expectError(replaced(kSmall, "<_>2 3 8 4 -1.</_>", "<_>2 3 999999999 999999999 -1.</_>"), "outside the 24x20 window");
+}
+
+TEST(OpenCvCascade, TreesAreReadNodeByNodeAndBadChildrenRejected) {
+  const std::string tree = replaced(kSmall, "<_><internalNodes>0 -1 1 1.</internalNodes><leafValues>0.3 -0.7</leafValues></_>",
+                                    "<_><internalNodes>1 -1 1 1. 0 -2 0 2.5</internalNodes><leafValues>0.3 -0.7 0.1</leafValues></_>");
+  const Cascade c = parseOpenCvCascade(tree, "tree.xml");
+  ASSERT_TRUE(c.hasTrees());
+  EXPECT_TRUE(c.stages[0].stumps.empty());
+  ASSERT_EQ(c.treeStages.size(), 2u);
+  ASSERT_EQ(c.treeStages[1].size(), 1u);
+  const Tree& t = c.treeStages[1][0];
+  ASSERT_EQ(t.nodes.size(), 2u);
+  EXPECT_EQ(t.nodes[0].left, 1);
+  EXPECT_EQ(t.nodes[0].right, -1);
+  EXPECT_EQ(t.nodes[1].feature, 0);
+  EXPECT_EQ(t.nodes[1].threshold, 2.5);
+  EXPECT_EQ(t.leaves[2], double(0.1f));
+  EXPECT_EQ(c.weakCount(), 3u);
+  EXPECT_NO_THROW(parseOpenCvCascade(replaced(tree, "1 -1 1 1. 0 -2 0 2.5", "1 -1 1 1. 0 -1 0 2.5"), "t.xml"));
+  expectError(replaced(tree, "1 -1 1 1. 0 -2 0 2.5", "1 -1 1 1. 1 -2 0 2.5"), "must be a later node or a leaf");
+  expectError(replaced(tree, "1 -1 1 1. 0 -2 0 2.5", "1 -1 1 1. 0 -7 0 2.5"), "must be a later node or a leaf");
 }
 
 TEST(OpenCvCascade, NonFiniteNumbersAreReported) {

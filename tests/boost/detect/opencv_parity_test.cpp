@@ -169,4 +169,6 @@ TEST(OpenCvParity, ProfileFace) { checkParity("haarcascade_profileface.xml"); }
 TEST(OpenCvParity, Eye) { checkParity("haarcascade_eye.xml"); }
 TEST(OpenCvParity, FrontalCatFace) { checkParity("haarcascade_frontalcatface.xml"); }
 TEST(OpenCvParity, FullBodyWithTiltedFeatures) { checkParity("haarcascade_fullbody.xml"); }
+TEST(OpenCvParity, FrontalFaceAlt2Trees) { checkParity("haarcascade_frontalface_alt2.xml"); }
+TEST(OpenCvParity, EyeTreeEyeglassesTiltedTrees) { checkParity("haarcascade_eye_tree_eyeglasses.xml"); }
 TEST(OpenCvParity, OldFormatLicencePlate) { checkParity("haarcascade_licence_plate_rus_16stages.xml"); }

@@ -36,9 +36,22 @@ struct Stump {
   double left = 0, right = 0;
 };
 
+// A decision tree, only in imported OpenCV cascades whose weak classifiers split more than once
+// (alt2, *_2splits, eye_tree_eyeglasses). From node 0: value < threshold ? left : right; a child
+// > 0 is a node index (always greater than its parent's), a child <= 0 is the leaf -child.
+struct TreeNode {
+  int feature = 0;  // index into Cascade::haarFeatures
+  double threshold = 0;
+  int left = 0, right = 0;
+};
+struct Tree {
+  std::vector<TreeNode> nodes;
+  std::vector<double> leaves;  // nodes.size() + 1
+};
+
 struct Stage {
   std::vector<Stump> stumps;
-  double threshold = 0;  // stage passes when sum of stump outputs >= threshold
+  double threshold = 0;  // stage passes when sum of its weak classifiers' outputs >= threshold
 };
 
 // OpenCV Haar feature: up to three weighted rectangles in base-window pixels. Tilted rectangles
@@ -62,11 +75,15 @@ struct Cascade {
   std::vector<Feature> features;          // kNone
   std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
   std::vector<Stage> stages;
+  // OpenCV tree cascades only: the weak classifiers of stage i are treeStages[i] (instead of
+  // stages[i].stumps, which stay empty; stages[i].threshold applies). Empty for every other model.
+  std::vector<std::vector<Tree>> treeStages;
   std::string source;  // file the model came from (for messages), may be empty
 
   double aspectRatio() const { return double(windowWidth) / double(windowHeight); }
   bool isOpenCv() const { return normalization == Normalization::kOpenCvVariance; }
-  std::size_t weakCount() const;
+  bool hasTrees() const;
+  std::size_t weakCount() const;  // stumps + trees
   // Adds a feature (our kind) and returns its index for Stump::feature.
   int addFeature(const Feature& f);
 

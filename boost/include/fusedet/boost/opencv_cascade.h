@@ -10,8 +10,9 @@
 // for bit: thresholds and leaves rounded to float, leaves below 1e-5 in magnitude set to 0, stage
 // thresholds lowered by 1e-5 (OpenCV's THRESHOLD_EPS).
 //
-// Weak classifiers must be stumps (one split); cascades of deeper trees (alt2, *_2splits,
-// eye_tree_eyeglasses) and LBP/HOG cascades are rejected with a clear message.
+// Weak classifiers that split once become Stumps; cascades with deeper trees (alt2, *_2splits,
+// eye_tree_eyeglasses) keep them as Trees (cascade.h) and run on the one-window-at-a-time path.
+// LBP/HOG cascades are rejected with a clear message.
 
 #include <filesystem>
 #include <string>
