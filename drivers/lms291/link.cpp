@@ -55,7 +55,7 @@ Result<std::optional<StreamEvent>> Link::nextEvent(Clock::time_point deadline) {
   // pending "frame" was garbage (e.g. a stray STX with a large length).
   const auto gap = std::chrono::microseconds(
       std::max<std::int64_t>(20'000, static_cast<std::int64_t>(byteSeconds(std::max(port_.baud(), 1)) * 1e6 * 20)));
-  std::array<std::uint8_t, 4096> buffer{};
+  std::array<std::uint8_t, 16384> buffer{};
   for (;;) {
     if (auto e = reader_.next()) return std::optional<StreamEvent>(std::move(*e));
     if (cancel_ && cancel_->load()) return makeError(std::errc::operation_canceled, "cancelled");

@@ -1,5 +1,7 @@
 #include "fusedet/drivers/lms291/telegram.h"
 
+#include <algorithm>
+
 namespace fusedet::drivers::lms291 {
 
 std::uint16_t crc16(std::span<const std::uint8_t> bytes) {
@@ -56,10 +58,26 @@ Stamp TelegramReader::arrival(std::size_t endOffset) {
   return lastFeed_;
 }
 
+// A backlog (the reader fell behind, the kernel buffer held many telegrams) makes the per-byte
+// estimate too early for later chunks: a telegram cannot end before the previous one ended
+// plus its own line time, nor after the chunk holding it was read.
+Stamp TelegramReader::telegramArrival(std::size_t endOffset, std::size_t frameSize) {
+  Stamp readAt = lastFeed_;
+  for (const auto& [chunkEnd, stamp] : chunks_)
+    if (chunkEnd >= endOffset) {
+      readAt = stamp;
+      break;
+    }
+  Stamp t = arrival(endOffset);
+  if (lastTelegramEnd_.ns != 0) t = std::max(t, lastTelegramEnd_ + static_cast<std::int64_t>(frameSize) * byteNs_);
+  return std::min(t, readAt);
+}
+
 void TelegramReader::clear() {
   bufferOffset_ += buffer_.size();
   buffer_.clear();
   chunks_.clear();
+  lastTelegramEnd_ = Stamp{};
   inGarbage_ = false;
   releaseLone_ = false;
 }
@@ -126,7 +144,7 @@ std::optional<StreamEvent> TelegramReader::next() {
 
     StreamEvent e;
     e.offset = bufferOffset_;
-    e.received = arrival(bufferOffset_ + frameSize);
+    e.received = ok ? telegramArrival(bufferOffset_ + frameSize, frameSize) : arrival(bufferOffset_ + frameSize);
     Telegram& t = e.telegram;
     t.address = raw[1];
     t.command = raw[4];
@@ -140,6 +158,7 @@ std::optional<StreamEvent> TelegramReader::next() {
     if (ok) {
       e.kind = StreamEvent::Kind::kTelegram;
       ++counters_.telegrams;
+      lastTelegramEnd_ = e.received;
       buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(frameSize));
       bufferOffset_ += frameSize;
       inGarbage_ = false;

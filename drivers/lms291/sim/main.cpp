@@ -28,7 +28,12 @@ int main(int argc, char** argv) {
       "sends at a speed other than the device's are ignored; output is not delivered while the\n"
       "host's speed differs (a UART would drop it as framing errors).",
       "lms291-sim"};
-  app.add_option("--link", o.link, "create this symlink to the pty's slave side (the host opens it)")->required();
+  auto* link = app.add_option("--link", o.link, "create a pty and this symlink to its slave side (the host opens it)");
+  auto* attach = app.add_option("--attach", o.attach,
+                                "use this existing tty instead (a socat/qemu pty end or a real serial port); the host's "
+                                "speed is not observable there and is taken to match");
+  link->excludes(attach);
+  attach->excludes(link);
   app.add_option("--type", o.type, "type string (reply to 0x3A); contains S14 = LMS Fast (no 0x3B)")->capture_default_str();
   app.add_option("--power-on-baud", o.powerOnBaud, "speed after power-on (9600 unless the permanent-baud flag is set)")
       ->check(CLI::IsMember({9600, 19200, 38400, 500000}))->capture_default_str();
@@ -58,8 +63,13 @@ int main(int argc, char** argv) {
       "  lms291-sim --link /tmp/lms &                    # then: fusedet lms stream /tmp/lms\n"
       "  lms291-sim --link /tmp/lms --flip-rate 0.01     # 1 % corrupted bytes\n"
       "  lms291-sim --link /tmp/lms --vanish-every 5 --vanish-for 1\n"
+      "  socat pty,raw,link=/tmp/a pty,raw,link=/tmp/b & lms291-sim --attach /tmp/a   # host opens /tmp/b\n"
       "Exit status: 0 after a clean stop, 1 on bad options or when the pty cannot be created.");
   CLI11_PARSE(app, argc, argv);
+  if (o.link.empty() && o.attach.empty()) {
+    std::cerr << "lms291-sim: error: give --link PATH (new pty) or --attach TTY\n";
+    return 1;
+  }
 
   o.variant = Variant{angle, static_cast<int>(std::lround(resolution * 100))};
   if (!o.variant.valid()) {
@@ -85,7 +95,8 @@ int main(int argc, char** argv) {
     std::cerr << "lms291-sim: error: " << r.error().message() << "\n";
     return 1;
   }
-  std::printf("lms291-sim: device %s linked at %s\n", device.slavePath().c_str(), o.link.c_str());
+  std::printf("lms291-sim: device %s linked at %s\n", device.slavePath().c_str(),
+              o.link.empty() ? o.attach.c_str() : o.link.c_str());
   std::fflush(stdout);
 
   using Clock = std::chrono::steady_clock;

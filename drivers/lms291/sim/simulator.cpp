@@ -63,14 +63,36 @@ Result<void> Simulator::createPty() {
   return {};
 }
 
+Result<void> Simulator::attachTty() {
+  auto port = SerialPort::open(options_.attach, options_.powerOnBaud);
+  if (!port) return port.error();
+  master_.reset(port->fd() >= 0 ? ::dup(port->fd()) : -1);
+  if (!master_.valid()) return errnoError(errno, "dup " + options_.attach);
+  slavePath_ = options_.attach;
+  return {};
+}
+
 void Simulator::destroyPty() {
   if (!options_.link.empty()) ::unlink(options_.link.c_str());
   master_.reset();
   slaveHold_.reset();
 }
 
+void Simulator::setDeviceBaud(int baud) {
+  baud_ = baud;
+  if (!options_.attach.empty() && master_.valid()) {
+    // Our side of a real line runs at the device's speed.
+    termios t{};
+    if (tcgetattr(master_.get(), &t) == 0) {
+      speed_t s = baud == 9600 ? B9600 : baud == 19200 ? B19200 : baud == 38400 ? B38400 : B500000;
+      cfsetspeed(&t, s);
+      (void)tcsetattr(master_.get(), TCSADRAIN, &t);
+    }
+  }
+}
+
 void Simulator::powerOn() {
-  baud_ = options_.powerOnBaud;
+  setDeviceBaud(options_.powerOnBaud);
   mode_ = static_cast<std::uint8_t>(Mode::kMonitoring);
   variant_ = options_.variant;
   out_.clear();
@@ -90,7 +112,7 @@ void Simulator::powerOn() {
 Result<void> Simulator::start() {
   std::lock_guard lock(mutex_);
   if (running_) return {};
-  if (auto r = createPty(); !r) return r;
+  if (auto r = openLine(); !r) return r;
   present_ = true;
   powerOn();
   running_ = true;
@@ -165,6 +187,7 @@ void Simulator::vanish(std::chrono::milliseconds d) {
 }
 
 int Simulator::hostBaud() const {
+  if (!options_.attach.empty()) return baud_;  // not observable: assume the host follows
   int b = 0;
   if (!master_.valid() || detail::getBaudTermios2(master_.get(), &b) != 0) return 0;
   return b;
@@ -435,7 +458,7 @@ void Simulator::pumpOutput(Clock::time_point now) {
         }
       }
     }
-    if (o.baudAfter) baud_ = o.baudAfter;
+    if (o.baudAfter) setDeviceBaud(o.baudAfter);
     out_.pop_front();
     outPos_ = 0;
     outDamaged_ = false;
@@ -456,7 +479,7 @@ void Simulator::run() {
       vanishRequest_ = std::chrono::milliseconds(-1);
     }
     if (!present_) {
-      if (now >= reappearAt_ && createPty()) {
+      if (now >= reappearAt_ && openLine()) {
         present_ = true;
         powerOn();
       } else {

@@ -45,6 +45,10 @@ struct Faults {
 
 struct SimOptions {
   std::string link;                    // symlink to the slave ("" = none)
+  // Attach to an existing tty instead of creating a pty (a socat/qemu pty end, or a real serial
+  // port): the other side's speed cannot be read there, so bytes are taken to match; on a real
+  // port the simulator sets the line speed itself and a mismatch is physical.
+  std::string attach;
   std::string type = "LMS291;S05";     // reply to 0x3A
   std::string firmware = "V02.10 ";    // 7 characters
   int powerOnBaud = 9600;              // as if the permanent-baud flag were set, if not 9600
@@ -126,6 +130,8 @@ class Simulator {
   using Clock = std::chrono::steady_clock;
 
   Result<void> createPty();
+  Result<void> attachTty();
+  Result<void> openLine() { return options_.attach.empty() ? createPty() : attachTty(); }
   void destroyPty();
   void powerOn();
   void run();
@@ -137,6 +143,7 @@ class Simulator {
   std::uint16_t encodeRange(double meters) const;
   void pumpOutput(Clock::time_point now);
   int hostBaud() const;
+  void setDeviceBaud(int baud);
 
   SimOptions options_;
   Scene scene_;

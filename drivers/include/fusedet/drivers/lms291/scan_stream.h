@@ -36,6 +36,11 @@ class ScanStream {
   ScanStream(const ScanStream&) = delete;
   ScanStream& operator=(const ScanStream&) = delete;
 
+  // Recording hook: every raw chunk read from the port with its stamp (call before start()).
+  void setRawHook(std::function<void(std::span<const std::uint8_t>, Stamp)> hook) {
+    device_.link().setRawHook(std::move(hook));
+  }
+
   void start();
   // Streaming off, device back to 9600 (if reachable), thread joined. Returns the result of
   // the device stop (ok if the device was not connected).

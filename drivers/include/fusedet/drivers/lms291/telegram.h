@@ -105,6 +105,7 @@ class TelegramReader {
   bool plausibleHeader(std::size_t at, std::size_t* frameSize) const;
   void skip(std::size_t n);
   Stamp arrival(std::size_t endOffset);  // when the byte before stream offset endOffset arrived
+  Stamp telegramArrival(std::size_t endOffset, std::size_t frameSize);
 
   Direction direction_;
   std::deque<std::uint8_t> buffer_;
@@ -112,6 +113,7 @@ class TelegramReader {
   Stamp lastFeed_;
   std::deque<std::pair<std::size_t, Stamp>> chunks_;  // (stream offset after the chunk, read time)
   std::int64_t byteNs_ = 0;
+  Stamp lastTelegramEnd_;
   bool inGarbage_ = false;
   bool releaseLone_ = false;  // a trailing ACK/NAK byte was followed by silence
   ReaderCounters counters_;
