@@ -155,6 +155,11 @@ std::string renderMarkdown(const ExperimentReport& r) {
     table(md, {"setting", "value"}, body);
   }
 
+  if (!r.failures.empty()) {
+    md << "## Not evaluated\n\n";
+    for (const std::string& f : r.failures) md << "- " << f << "\n";
+    md << "\n";
+  }
   md << "## Results in the paper's layout\n\n"
         "Length is the number of weak classifiers (stumps) in the cascade, summed over both cascades "
         "for the AND combination. Recall, precision and F-measure on the test frames: a detection "
@@ -275,6 +280,7 @@ json toJson(const ExperimentReport& r) {
   j["test_stacks"] = r.testStacks;
   j["total_seconds"] = r.totalSeconds;
   j["settings"] = r.settings;
+  j["failures"] = r.failures;
   j["counts"] = json::array();
   for (const SplitCounts& c : r.counts)
     j["counts"].push_back({{"class", c.className},

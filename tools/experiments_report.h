@@ -50,6 +50,7 @@ struct ExperimentReport {
   std::vector<SplitCounts> counts;
   std::vector<ConfigResult> results;
   std::map<std::string, std::string> settings;  // shown in a table and in results.json
+  std::vector<std::string> failures;            // configurations that could not be trained, and why
   double totalSeconds = 0;
 };
 

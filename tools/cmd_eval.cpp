@@ -1,0 +1,195 @@
+// fusedet eval: a trained cascade (or the AND of several) on the frames of a data set - recall,
+// precision, F-measure, cascade length, weight share per layer (paper Fig. 7), share of corner
+// features and detection time, as a markdown table or JSON.
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "command.h"
+#include "experiments_data.h"
+#include "experiments_report.h"
+#include "experiments_run.h"
+#include "fusedet/boost/model_io.h"
+
+namespace fusedet::tools {
+namespace {
+namespace fs = std::filesystem;
+using namespace experiments;
+using nlohmann::json;
+
+struct EvalOptions {
+  std::vector<fs::path> models;
+  fs::path data;
+  std::string split = "test";
+  double trainFraction = 2.0 / 3.0;
+  bool json = false;
+  double minIou = 0.5, minHeight = 25, maxTruncation = -1;
+  int maxOcclusion = 1;
+  std::string van = "negative";
+  double scaleFactor = 1.1, step = 2;
+  int minNeighbors = 3;
+  int threads = 1;
+};
+
+std::string pct(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f %%", 100 * v);
+  return buf;
+}
+
+int runEval(const EvalOptions& o) {
+  if (!fs::exists(o.data / "dataset.json"))
+    throw std::runtime_error(o.data.string() + ": not a data set (no dataset.json); import KITTI drives with "
+                                               "`fusedet import-kitti --out DIR` first");
+  std::vector<boosting::Detector> detectors;
+  std::vector<boosting::CascadeSummary> summaries;
+  for (const fs::path& m : o.models) {
+    boosting::Cascade c = boosting::loadModel(m);
+    summaries.push_back(boosting::summarizeCascade(c));
+    detectors.emplace_back(std::move(c));
+  }
+  const std::string cls = detectors.front().cascade().className;
+  for (const auto& d : detectors)
+    if (d.cascade().className != cls)
+      throw std::runtime_error(d.cascade().source + ": class '" + d.cascade().className +
+                               "' differs from the first model's '" + cls + "'; AND needs one class");
+
+  const std::vector<DatasetEntry> manifest = readDatasetManifest(o.data);
+  std::vector<DatasetEntry> entries;
+  if (o.split == "all") {
+    entries = manifest;
+  } else {
+    const Split s = splitByFrame(manifest, o.trainFraction);
+    entries = o.split == "train" ? s.train : s.test;
+  }
+  // Layers the models read; hue_distance is derived from hue with each model's reference hue.
+  std::vector<std::string> layers;
+  for (const auto& d : detectors)
+    for (const std::string& l : d.cascade().layers) {
+      const std::string need = l == "hue_distance" ? "hue" : l;
+      if (std::find(layers.begin(), layers.end(), need) == layers.end()) layers.push_back(need);
+    }
+  std::vector<DatasetItem> items;
+  for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(o.data, e.id, layers));
+
+  boosting::MatchConfig match = matchConfigFor(cls, parseVanPolicy(o.van));
+  match.minIou = o.minIou;
+  match.minHeight = o.minHeight;
+  match.maxOcclusion = o.maxOcclusion;
+  match.maxTruncation = o.maxTruncation;
+  DetectionSetup setup;
+  setup.scan.scaleFactor = o.scaleFactor;
+  setup.scan.step = o.step;
+  setup.scan.threads = o.threads;
+  setup.group.minNeighbors = o.minNeighbors;
+  std::vector<const boosting::Detector*> chain;
+  for (const auto& d : detectors) chain.push_back(&d);
+  const EvalOutcome r = evaluateChain(chain, items, match, setup);
+  const boosting::CascadeSummary s = summaries.size() == 1 ? summaries.front() : boosting::combineSummaries(summaries);
+
+  if (o.json) {
+    json j;
+    j["class"] = cls;
+    j["models"] = json::array();
+    for (const fs::path& m : o.models) j["models"].push_back(m.string());
+    j["data"] = o.data.string();
+    j["split"] = o.split;
+    j["stacks"] = r.counts.stacks;
+    j["recall"] = r.counts.recall();
+    j["precision"] = r.counts.precision();
+    j["f_measure"] = r.counts.fMeasure();
+    j["hits"] = r.counts.hits;
+    j["false_alarms"] = r.counts.falseAlarms;
+    j["misses"] = r.counts.misses;
+    j["positives"] = r.counts.positives;
+    j["ignored_detections"] = r.counts.ignored;
+    j["length"] = s.length;
+    j["stages"] = s.stages;
+    j["layer_weight_share"] = s.layerWeightShare;
+    j["layer_stump_count"] = s.layerCount;
+    j["corner_share"] = s.cornerShare();
+    j["ms_per_stack"] = r.msPerStack;
+    j["windows"] = r.windows;
+    j["match"] = {{"min_iou", match.minIou}, {"min_height", match.minHeight}, {"max_occlusion", match.maxOcclusion},
+                  {"max_truncation", match.maxTruncation}, {"van", o.van}};
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("# fusedet eval: %s\n\n", cls.c_str());
+  std::printf("Model%s:", o.models.size() > 1 ? "s (AND: a window must pass each)" : "");
+  for (const fs::path& m : o.models) std::printf(" `%s`", m.c_str());
+  std::printf("\n\nData: `%s`, %s split, %zu stacks. Match: IoU >= %.2f; labels lower than %.0f px or occluded "
+              "more than level %d are ignored, as are ignore regions; van: %s.\n\n",
+              o.data.c_str(), o.split.c_str(), r.counts.stacks, match.minIou, match.minHeight, match.maxOcclusion,
+              o.van.c_str());
+  std::printf("| measure | value |\n|---|---:|\n");
+  std::printf("| length (stumps) | %zu |\n| stages | %zu |\n", s.length, s.stages);
+  std::printf("| recall | %.3f |\n| precision | %.3f |\n| F-measure | %.3f |\n", r.counts.recall(),
+              r.counts.precision(), r.counts.fMeasure());
+  std::printf("| hits / false alarms / misses | %zu / %zu / %zu |\n", r.counts.hits, r.counts.falseAlarms,
+              r.counts.misses);
+  std::printf("| positives | %zu |\n| ignored detections | %zu |\n", r.counts.positives, r.counts.ignored);
+  std::printf("| corner features | %s |\n| ms per stack | %.1f |\n\n", pct(s.cornerShare()).c_str(), r.msPerStack);
+  std::printf("| layer | weight share | stumps |\n|---|---:|---:|\n");
+  for (const std::string& l : orderedLayers(s.layerWeightShare))
+    std::printf("| %s | %s | %zu |\n", l.c_str(), pct(s.layerWeightShare.at(l)).c_str(),
+                s.layerCount.count(l) ? s.layerCount.at(l) : std::size_t{0});
+  return 0;
+}
+
+const bool registered = registerCommand(
+    "eval", "Evaluate a trained cascade on a data set: recall, precision, F-measure, length, weight share per layer",
+    [](CLI::App& app) {
+      auto o = std::make_shared<EvalOptions>();
+      app.add_option("--model,-m", o->models,
+                     "model file (fusedet-cascade JSON); give it twice or more for the AND of the cascades "
+                     "(a window must pass each; all of one class)")
+          ->required()
+          ->check(CLI::ExistingFile);
+      app.add_option("--data", o->data, "data set directory (dataset.json; see docs/dataset-format.md)")->required();
+      app.add_option("--split", o->split,
+                     "frames to evaluate: test (the last third of each group's frames), train (the first two "
+                     "thirds), all")
+          ->check(CLI::IsMember({"test", "train", "all"}))
+          ->capture_default_str();
+      app.add_option("--train-fraction", o->trainFraction, "share of each group's first frames that train")
+          ->check(CLI::Range(0.05, 0.95))
+          ->capture_default_str();
+      app.add_flag("--json", o->json,
+                   "print one JSON object (recall, precision, f_measure, length, stages, layer_weight_share, "
+                   "layer_stump_count, corner_share, ms_per_stack, counts) instead of markdown");
+      app.add_option("--min-iou", o->minIou, "a detection hits a label at IoU >= this")
+          ->check(CLI::Range(0.01, 1.0))
+          ->capture_default_str();
+      app.add_option("--min-height", o->minHeight, "labels lower than this [px] are ignored (KITTI moderate: 25)")
+          ->capture_default_str();
+      app.add_option("--max-occlusion", o->maxOcclusion, "labels occluded more are ignored (KITTI moderate: 1)")
+          ->capture_default_str();
+      app.add_option("--max-truncation", o->maxTruncation,
+                     "labels truncated more are ignored; < 0 = not checked (KITTI tracking labels hold levels)")
+          ->capture_default_str();
+      app.add_option("--van", o->van, "a van for the car class: negative (false alarm), ignore, positive")
+          ->check(CLI::IsMember({"negative", "ignore", "positive"}))
+          ->capture_default_str();
+      app.add_option("--scale-factor", o->scaleFactor, "window scale step")->capture_default_str();
+      app.add_option("--step", o->step, "position step in base-window pixels")->capture_default_str();
+      app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
+      app.add_option("--threads", o->threads, "detection threads (ms per stack is measured with these)")
+          ->capture_default_str();
+      app.footer(
+          "Weight share per layer: each stump weighs |right leaf - left leaf| (how far it moves the stage "
+          "sum), summed per layer over all stages and divided by the total (paper Fig. 7).\n"
+          "Ignore regions (DontCare, Truck, Tram, Misc, Person_sitting) absorb a detection lying inside them "
+          "by >= min-iou of its area.\n\n"
+          "Examples:\n"
+          "  fusedet eval -m models/car.json --data /tmp/kitti-ds\n"
+          "  fusedet eval -m car_laser.json -m car_camera.json --data ds --json   # AND combination\n"
+          "  fusedet eval -m models/person.json --data ds --split all --min-height 40");
+      return [o] { return runEval(*o); };
+    });
+
+}  // namespace
+}  // namespace fusedet::tools
