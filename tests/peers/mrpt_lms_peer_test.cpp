@@ -90,7 +90,8 @@ TEST(MrptPeer, CSickLaserSerialReadsScansFromLms291SimAt38400) {
   ASSERT_EQ(sim.device.rfind("/dev/", 0), 0u) << sim.device;
 
   mrpt::hwdrivers::CSickLaserSerial laser;
-  laser.setSerialPort(sim.device);  // MRPT wants a /dev name
+  // The link, not /dev/pts/N: a pty number can be reused by another test once this one ends.
+  laser.setSerialPort(dir + "/tty");
   laser.setBaudRate(38400);
   laser.setMillimeterMode(true);
   laser.setScanFOV(180);
