@@ -131,6 +131,9 @@ Result<void> Lms291::switchBaud(int baud) {
   link_.flushInput();
   auto s = queryStatus();
   if (!s) return Error{s.error().code, "verify " + std::to_string(baud) + " baud: " + s.error().message()};
+  // The answer proves the speed; the baud word's offset is disputed (115 vs 116), so only log.
+  if (s->baud != baud)
+    spdlog::debug("lms291 {}: status reports {} baud after switching to {}", config_.device, s->baud.value_or(0), baud);
   return {};
 }
 
@@ -193,9 +196,9 @@ Result<DeviceInfo> Lms291::start() {
   auto type = queryType();
   if (!type) return type.error();
   info.type = *type;
-  const bool fast = info.type.find("S14") != std::string::npos;
-  if (config_.remission && fast)
-    return makeError(std::errc::not_supported, "remission: " + info.type + " sends range+reflectivity as C4, not supported");
+  // LMS Fast (S14): fixed 90 deg at 0.5 deg, no variants, reflectivity as C4 - not modelled here.
+  if (info.type.find("S14") != std::string::npos)
+    return makeError(std::errc::not_supported, info.type + " (LMS Fast, fixed 90 deg) is not supported by this driver");
 
   auto cfg = readConfig();
   if (!cfg) return cfg.error();
@@ -210,12 +213,11 @@ Result<DeviceInfo> Lms291::start() {
   activeMeasuringMode_ = wanted.bytes[5];
   activeUnit_ = Unit::kMm;
 
-  if (!fast)
-    if (auto r = setVariant(config_.variant); !r) return r.error();
+  if (auto r = setVariant(config_.variant); !r) return r.error();
   auto status = queryStatus();
   if (!status) return status.error();
   info.status = *status;
-  if (!fast && (status->angleDeg != config_.variant.angleDeg || status->resolutionCdeg != config_.variant.resolutionCdeg))
+  if (status->angleDeg != config_.variant.angleDeg || status->resolutionCdeg != config_.variant.resolutionCdeg)
     return protocolError("device reports " + std::to_string(status->angleDeg) + " deg / " +
                          std::to_string(status->resolutionCdeg) + " cdeg after setting the variant");
   assembler_.reset(config_.variant);
@@ -288,7 +290,9 @@ std::optional<LaserScan> Lms291::handle(const Telegram& t) {
       ++counters_.badScans;
       return std::nullopt;
     }
-    if (mv->telegramIndex) {
+    // Telegram-index gaps count lost scans in full-scan modes; with partial scans the
+    // assembler counts the groups that a lost partial broke.
+    if (mv->telegramIndex && !mv->countWord.partial) {
       if (lastTelegramIndex_) {
         const int gap = (*mv->telegramIndex - *lastTelegramIndex_ - 1 + 256) % 256;
         counters_.lostScans += static_cast<std::uint64_t>(gap);

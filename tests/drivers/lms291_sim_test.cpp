@@ -468,6 +468,51 @@ TEST_F(LmsSim, StatusWarningsAreSurfacedOnScans) {
   EXPECT_TRUE(lms.stop());
 }
 
+TEST_F(LmsSim, LmsFastIsRefusedWithAClearError) {
+  sim::SimOptions o;
+  o.type = "LMS291;S14";
+  startSim(o);
+  Lms291 lms(config(38400));
+  auto info = lms.start();
+  ASSERT_FALSE(info);
+  EXPECT_EQ(info.error().code, std::errc::not_supported);
+  EXPECT_NE(info.error().message().find("LMS291;S14"), std::string::npos) << info.error().message();
+  EXPECT_TRUE(lms.stop());
+  EXPECT_EQ(sim_->state().baud, 9600);
+}
+
+TEST_F(LmsSim, InterlacedHalfDegreeUnderCorruptionDropsOnlyBrokenGroups) {
+  sim::SimOptions o;
+  o.seed = 77;
+  startSim(o);
+  auto c = config(500000, {180, 50});  // 2 partial scans of 181 + 180 beams per full scan
+  c.interlaced = true;
+  Lms291 lms(c);
+  ASSERT_TRUE(lms.start());
+  sim::Faults f;
+  f.bitFlipRate = 0.001;
+  sim_->setFaults(f);
+  int scans = 0;
+  const auto end = Clock::now() + 3s;
+  while (Clock::now() < end) {
+    auto s = lms.readScan(500ms);
+    if (!s) continue;
+    ASSERT_EQ(s->size(), 361u);
+    if (sim_->crcBlindScans().empty()) {
+      ASSERT_TRUE(matchesRoom(*s, false));
+    }
+    ++scans;
+  }
+  sim_->setFaults({});
+  const auto k = lms.counters();
+  std::printf("interlaced 0.5 deg, 0.1%% flips: %d merged scans, %llu broken groups, %llu damaged partials\n", scans,
+              (unsigned long long)k.lostScans, (unsigned long long)sim_->counters().scansDamaged);
+  EXPECT_GT(scans, 30);
+  EXPECT_GT(k.lostScans, 0u);
+  EXPECT_LE(k.lostScans, sim_->counters().scansDamaged);
+  EXPECT_TRUE(lms.stop());
+}
+
 TEST_F(LmsSim, Termios2PathAt500k) {
   sim::SimOptions o;
   startSim(o);
