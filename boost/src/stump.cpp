@@ -45,6 +45,28 @@ inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t beg
   for (; i < end; ++i) hist[0][bins[i]] += w[i];
 }
 
+// Two features in one pass: the weight is loaded once for both scatters (a quarter fewer
+// loads per entry than one feature at a time).
+inline void accumulatePair(const std::uint8_t* b0, const std::uint8_t* b1, const float* w, std::size_t begin,
+                           std::size_t end, float (*h0)[kBins], float (*h1)[kBins]) {
+  std::size_t i = begin;
+  for (; i + kLanes <= end; i += kLanes) {
+    const float w0 = w[i], w1 = w[i + 1], w2 = w[i + 2], w3 = w[i + 3];
+    h0[0][b0[i]] += w0;
+    h1[0][b1[i]] += w0;
+    h0[1][b0[i + 1]] += w1;
+    h1[1][b1[i + 1]] += w1;
+    h0[2][b0[i + 2]] += w2;
+    h1[2][b1[i + 2]] += w2;
+    h0[3][b0[i + 3]] += w3;
+    h1[3][b1[i + 3]] += w3;
+  }
+  for (; i < end; ++i) {
+    h0[0][b0[i]] += w[i];
+    h1[0][b1[i]] += w[i];
+  }
+}
+
 // Best split of one feature's histogram (pos/neg weight per bin), or gain -1 if none.
 SplitCandidate scanBins(std::size_t feature, const float (*pos)[kBins], const float (*neg)[kBins]) {
   std::array<double, kBins> wp{}, wn{};
@@ -90,18 +112,29 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-                        alignas(64) float pos[kLanes][kBins];
-                        alignas(64) float neg[kLanes][kBins];
+                        alignas(64) float pos[2][kLanes][kBins];
+                        alignas(64) float neg[2][kLanes][kBins];
                         for (std::size_t c = r.begin(); c != r.end(); ++c) {
                           std::vector<SplitCandidate> top;
                           const std::size_t end = std::min(m.features(), (c + 1) * kChunk);
-                          for (std::size_t f = c * kChunk; f < end; ++f) {
+                          std::size_t f = c * kChunk;
+                          for (; f + 1 < end; f += 2) {
                             std::memset(pos, 0, sizeof pos);
                             std::memset(neg, 0, sizeof neg);
-                            const std::uint8_t* bins = m.row(f);
-                            accumulate(bins, weights.data(), 0, positives, pos);
-                            accumulate(bins, weights.data(), positives, n, neg);
-                            const SplitCandidate s = scanBins(f, pos, neg);
+                            const std::uint8_t *b0 = m.row(f), *b1 = m.row(f + 1);
+                            accumulatePair(b0, b1, weights.data(), 0, positives, pos[0], pos[1]);
+                            accumulatePair(b0, b1, weights.data(), positives, n, neg[0], neg[1]);
+                            for (int q = 0; q < 2; ++q) {
+                              const SplitCandidate s = scanBins(f + std::size_t(q), pos[q], neg[q]);
+                              if (s.gain >= 0) keepTop(top, s, k);
+                            }
+                          }
+                          if (f < end) {
+                            std::memset(pos, 0, sizeof pos);
+                            std::memset(neg, 0, sizeof neg);
+                            accumulate(m.row(f), weights.data(), 0, positives, pos[0]);
+                            accumulate(m.row(f), weights.data(), positives, n, neg[0]);
+                            const SplitCandidate s = scanBins(f, pos[0], neg[0]);
                             if (s.gain >= 0) keepTop(top, s, k);
                           }
                           perChunk[c] = std::move(top);

@@ -4,6 +4,9 @@
 
 #include <opencv2/imgproc.hpp>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <random>
 
 #include "fusedet/boost/detector.h"
@@ -157,6 +160,14 @@ TEST(CascadeTrainer, SameSeedSameDataGivesByteIdenticalModelForAnyThreadCount) {
   c.threads = 2;
   const Cascade second = trainCascade(c, items, quiet);
   EXPECT_EQ(modelToText(second, {{"seed", "5"}}), one);
+  // And as files, byte for byte.
+  const auto dir = std::filesystem::temp_directory_path();
+  saveModel(second, dir / "fusedet_det_a.json", {{"seed", "5"}});
+  std::ifstream in(dir / "fusedet_det_a.json", std::ios::binary);
+  std::ostringstream content;
+  content << in.rdbuf();
+  const std::string bytes = content.str();
+  EXPECT_EQ(bytes, one);
   ASSERT_TRUE(second.referenceHue.has_value());
   EXPECT_DOUBLE_EQ(*second.referenceHue, 205.0);  // the cars' hue, 200, lies in bin 200-210
   c.seed = 6;
