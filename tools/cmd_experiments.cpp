@@ -169,9 +169,10 @@ struct Preset {
 Preset presetFor(const ExperimentOptions& o) {
   // Full: the pool grid of feature_pool.h (16 units per side), stages of up to 100 stumps.
   // Quick: a coarse pool and a few small stages, to prove the whole pipeline in a few minutes.
-  // The full pool grid is 10 (54,250 features over 7 layers): grid 16 (352,576) costs ~6x the
-  // time per stage and does not fit 15 trainings into the hour on 2 cores.
-  Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4} : Preset{10, 14, 100, 1e-5, 0, 1.2, 3, 1.1, 2};
+  // Full: pool grid 12 (about 115,000 features over 7 layers; grid 16 has 352,576, ~3x the
+  // time per stage), a dense negative scan (about 27 million windows over the 54 training
+  // frames) so that the cascade can reach 1e-6 before the negatives run out.
+  Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4} : Preset{12, 20, 100, 1e-6, 0, 1.1, 2, 1.1, 2};
   if (o.grid > 0) p.grid = o.grid;
   if (o.maxStages > 0) p.maxStages = o.maxStages;
   if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
@@ -507,10 +508,10 @@ const bool registered = registerCommand(
                      "many KITTI pedestrians (default: 2, quick 1)")
           ->check(CLI::Range(0.5, 4.0));
       app.add_option("--haar-fullbody", o->haarFile, "OpenCV full-body cascade for the peer")->capture_default_str();
-      app.add_option("--grid", o->grid, "feature pool grid, units per side (default: 10, quick 6)");
-      app.add_option("--max-stages", o->maxStages, "stage limit (default: 14, quick 4)");
+      app.add_option("--grid", o->grid, "feature pool grid, units per side (default: 12, quick 6)");
+      app.add_option("--max-stages", o->maxStages, "stage limit (default: 20, quick 4)");
       app.add_option("--max-weak", o->maxWeak, "stumps per stage at most (default: 100, quick 5)");
-      app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-5, quick 1e-3)");
+      app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-6, quick 1e-3)");
       app.add_option("--negatives", o->negatives, "negatives per stage (default: max(500, 2 x positives), quick 200)");
       app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.1, quick 1.3)");
       app.add_option("--step", o->step, "detection position step in base-window pixels (default: 2, quick 4)");

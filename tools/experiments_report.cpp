@@ -66,26 +66,33 @@ void table(std::ostringstream& md, const std::vector<std::string>& header,
   md << "\n";
 }
 
+// Fewer test positives than this make a comparison a coin toss: the claim is "undecided".
+constexpr std::size_t kMinPositivesForClaim = 5;
+
 // A claim "a >= b" on F-measure, with both numbers; null when either was not evaluated.
+// verdict: "holds", "does not hold", or "undecided" (too few test positives, or both F are 0).
 json compare(const ConfigResult* a, const ConfigResult* b) {
   if (!a || !b) return nullptr;
   const double fa = a->counts.fMeasure(), fb = b->counts.fMeasure();
+  const bool undecided = a->counts.positives < kMinPositivesForClaim || (fa == 0 && fb == 0);
   return json{{"lhs", a->config},
               {"rhs", b->config},
               {"lhs_f_measure", fa},
               {"rhs_f_measure", fb},
               {"lhs_length", a->length},
               {"rhs_length", b->length},
-              {"holds", fa >= fb}};
+              {"test_positives", a->counts.positives},
+              {"holds", fa >= fb},
+              {"verdict", undecided ? "undecided" : (fa >= fb ? "holds" : "does not hold")}};
 }
 
 std::string claimText(const json& c, const std::string& what) {
   if (c.is_null()) return "- " + what + ": not evaluated\n";
   char buf[320];
-  std::snprintf(buf, sizeof buf, "- %s: **%s** (F %.2f vs %.2f; length %zu vs %zu)\n", what.c_str(),
-                c["holds"].get<bool>() ? "holds" : "does not hold", c["lhs_f_measure"].get<double>(),
+  std::snprintf(buf, sizeof buf, "- %s: **%s** (F %.2f vs %.2f; length %zu vs %zu; %zu test positives)\n",
+                what.c_str(), c["verdict"].get<std::string>().c_str(), c["lhs_f_measure"].get<double>(),
                 c["rhs_f_measure"].get<double>(), c["lhs_length"].get<std::size_t>(),
-                c["rhs_length"].get<std::size_t>());
+                c["rhs_length"].get<std::size_t>(), c["test_positives"].get<std::size_t>());
   return buf;
 }
 
@@ -257,7 +264,8 @@ std::string renderMarkdown(const ExperimentReport& r) {
 
   md << "## The paper's claims on this data\n\n"
         "Compared on the F-measure of the test frames (ties count as holding); lengths for the "
-        "paper's second argument, shorter cascades.\n\n";
+        "paper's second argument, shorter cascades. \"undecided\": fewer than 5 test positives, or F = 0 "
+        "on both sides.\n\n";
   for (const std::string& cls : r.classes) {
     const json c = claimsJson(r, cls);
     md << "### " << cls << "\n\n";

@@ -151,6 +151,10 @@ TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
   EXPECT_NE(md.find("### Tab. 2: all layers"), std::string::npos);
   EXPECT_NE(md.find("| F-measure | 0.90 |"), std::string::npos) << md;
   EXPECT_NE(md.find("joint pool (all layers) >= camera only: **does not hold** (F 0.90 vs 1.00"), std::string::npos);
+  EXPECT_EQ(j["claims"]["car"]["joint_ge_laser"]["verdict"], "holds");
+  // With too few test positives a claim is undecided, whatever the numbers.
+  for (ConfigResult& c : r.results) c.counts.positives = 4;
+  EXPECT_EQ(toJson(r)["claims"]["car"]["joint_ge_laser"]["verdict"], "undecided");
   EXPECT_EQ(md.find("Tab. 7"), std::string::npos);  // not evaluated, no table
   // Fig. 7 chart: distance (laser) bar three times as high as intensity's.
   const cv::Mat chart = weightShareChart("car", r.results[0].layerWeightShare);
