@@ -169,8 +169,8 @@ struct Preset {
 Preset presetFor(const ExperimentOptions& o) {
   // Full: the pool grid of feature_pool.h (16 units per side), stages of up to 100 stumps.
   // Quick: a coarse pool and a few small stages, to prove the whole pipeline in a few minutes.
-  // Full: pool grid 12 (about 115,000 features over 7 layers; grid 16 has 352,576, ~3x the
-  // time per stage), a dense negative scan (about 27 million windows over the 54 training
+  // Full: pool grid 12 (112,084 features over 7 layers; grid 16 has 352,576, ~3x the
+  // time per stage), a dense negative scan (32.7 million windows over the 54 training
   // frames) so that the cascade can reach 1e-6 before the negatives run out.
   Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4} : Preset{12, 20, 100, 1e-6, 0, 1.1, 2, 1.1, 2};
   if (o.grid > 0) p.grid = o.grid;
