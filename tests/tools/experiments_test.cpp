@@ -3,13 +3,18 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
+#include <iterator>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <opencv2/core.hpp>
 
 #include "../../tools/experiments_data.h"
 #include "../../tools/experiments_peers.h"
 #include "../../tools/experiments_report.h"
+#include "../../tools/experiments_run.h"
 #include "fusedet/fusion/kitti.h"
 
 namespace fusedet::tools::experiments {
@@ -160,6 +165,91 @@ TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
   const cv::Mat chart = weightShareChart("car", r.results[0].layerWeightShare);
   ASSERT_FALSE(chart.empty());
   EXPECT_EQ(orderedLayers(r.results[0].layerWeightShare), (std::vector<std::string>{"intensity", "distance"}));
+}
+
+}  // namespace
+}  // namespace fusedet::tools::experiments
+
+namespace fusedet::tools::experiments {
+namespace {
+
+// A one-stump cascade on one layer: accepts windows whose left half is brighter than the right.
+boosting::Cascade edgeCascade(const std::string& layerName, double threshold) {
+  boosting::Cascade c;
+  c.className = "car";
+  c.windowWidth = 24;
+  c.windowHeight = 24;
+  c.layers = {layerName};
+  const int f = c.addFeature({boosting::FeatureType::kEdgeHorizontal, {0, 0, 1, 1}, 0});
+  boosting::Stage s;
+  s.stumps = {boosting::Stump{f, threshold, -1, 1}};
+  s.threshold = 0;
+  c.stages = {s};
+  return c;
+}
+
+TEST(ExperimentsRun, AndChainKeepsExactlyTheWindowsBothCascadesAccept) {
+  cv::Mat a(96, 160, CV_32F), b(96, 160, CV_32F);
+  cv::RNG rng(7);
+  rng.fill(a, cv::RNG::UNIFORM, 0, 1);
+  rng.fill(b, cv::RNG::UNIFORM, 0, 1);
+  LayerStack stack(160, 96);
+  stack.set({"intensity", a, {}});
+  stack.set({"distance", b, {}});
+  const boosting::Detector camera(edgeCascade("intensity", 0.01));
+  const boosting::Detector laser(edgeCascade("distance", 0.01));
+  DetectionSetup setup;
+  setup.scan.scaleFactor = 1.25;
+  setup.scan.threads = 1;
+  setup.group.minNeighbors = 0;  // every accepted window becomes a detection: compare windows
+  const auto boxes = [](const std::vector<Detection>& d) {
+    std::set<std::array<double, 4>> s;
+    for (const Detection& x : d) s.insert({x.box.x, x.box.y, x.box.w, x.box.h});
+    return s;
+  };
+  const auto onlyLaser = boxes(detectChain({&laser}, stack, setup));
+  const auto onlyCamera = boxes(detectChain({&camera}, stack, setup));
+  const auto both = boxes(detectChain({&laser, &camera}, stack, setup));
+  std::set<std::array<double, 4>> expected;
+  std::set_intersection(onlyLaser.begin(), onlyLaser.end(), onlyCamera.begin(), onlyCamera.end(),
+                        std::inserter(expected, expected.begin()));
+  ASSERT_GT(onlyLaser.size(), 10u);  // random layers: roughly half the windows pass each
+  ASSERT_GT(onlyCamera.size(), 10u);
+  EXPECT_LT(expected.size(), onlyLaser.size());
+  EXPECT_EQ(both, expected);
+  // The order of the chain does not change which windows survive.
+  EXPECT_EQ(boxes(detectChain({&camera, &laser}, stack, setup)), expected);
+  EXPECT_THROW(detectChain({}, stack, setup), std::invalid_argument);
+}
+
+TEST(ExperimentsRun, EvaluateChainCountsOverItems) {
+  cv::Mat a(96, 160, CV_32F, cv::Scalar(0));
+  a(cv::Rect(40, 30, 12, 24)).setTo(1);  // a bright left half of a 24x24 window at (40, 30)
+  DatasetItem item;
+  item.id = "x/0";
+  item.stack = LayerStack(160, 96);
+  item.stack.set({"intensity", a, {}});
+  Label l;
+  l.className = "car";
+  l.box = {40, 30, 24, 24};
+  item.labels = {l};
+  const boosting::Detector det(edgeCascade("intensity", 0.5));
+  DetectionSetup setup;
+  setup.scan.threads = 1;
+  setup.scan.step = 1;
+  setup.scan.maxWidth = 24;  // base size only
+  setup.scan.maxHeight = 24;
+  setup.group.minNeighbors = 0;
+  boosting::MatchConfig match = matchConfigFor("car", VanPolicy::kNegative);
+  match.minHeight = 20;  // the 24 px test label would be below KITTI moderate
+  const EvalOutcome r = evaluateChain({&det}, {item, item}, match, setup);
+  EXPECT_EQ(r.counts.stacks, 2u);
+  EXPECT_EQ(r.counts.positives, 2u);
+  EXPECT_EQ(r.counts.hits, 2u);  // the window exactly on the label is accepted in both stacks
+  EXPECT_EQ(r.detections.size(), 2u);
+  // Neighbouring windows that also pass are false alarms (no grouping here).
+  EXPECT_EQ(r.counts.falseAlarms, 2 * (r.detections[0].size() - 1));
+  EXPECT_GT(r.msPerStack, 0.0);
 }
 
 }  // namespace
