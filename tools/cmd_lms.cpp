@@ -38,6 +38,7 @@ struct LmsOptions {
   double duration = 0;
   bool json = false;
   int pauseMs = 250;
+  std::string record;  // raw bytes read from the port, for `decode`
 };
 
 Lms291Config toConfig(const LmsOptions& o) {
@@ -97,6 +98,14 @@ int runStream(const LmsOptions& o) {
     }
     std::fflush(stdout);
   });
+  std::ofstream record;
+  if (!o.record.empty()) {
+    record.open(o.record, std::ios::binary | std::ios::trunc);
+    if (!record) throw std::runtime_error(o.record + ": cannot create");
+    stream.setRawHook([&record](std::span<const std::uint8_t> bytes, Stamp) {
+      record.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    });
+  }
   stream.start();
   const auto t0 = std::chrono::steady_clock::now();
   while (!gInterrupted) {
@@ -115,6 +124,10 @@ int runStream(const LmsOptions& o) {
                (unsigned long long)l.reader.crcErrors, (unsigned long long)l.reader.resyncs, (unsigned long long)l.naks,
                (unsigned long long)l.timeouts, (unsigned long long)l.retries, (unsigned long long)c.reconnects,
                c.lastError.empty() ? "" : "; last error: ", c.lastError.c_str());
+  if (record.is_open()) {
+    record.close();
+    if (!record) throw std::runtime_error(o.record + ": write error");
+  }
   if (!stopped) throw std::runtime_error("stop: " + stopped.error().message());
   return received > 0 ? 0 : 1;
 }
@@ -206,6 +219,7 @@ const bool registered = registerCommand(
       stream->add_option("--count", o->count, "stop after N scans (0 = no limit)")->capture_default_str();
       stream->add_option("--duration", o->duration, "stop after S seconds (0 = no limit)")->capture_default_str();
       stream->add_flag("--json", o->json, "one JSON object per scan (seq, stamp, angles, status, ranges [m], remissions)");
+      stream->add_option("--record", o->record, "write every byte read from the device to FILE (for `fusedet lms decode`)");
       CLI::App* decode = app.add_subcommand("decode", "print one JSON object per telegram in FILE (raw serial bytes)");
       decode->add_option("FILE", o->file, "a captured byte stream or a single telegram")->required();
       app.footer(
@@ -216,7 +230,10 @@ const bool registered = registerCommand(
           "  fusedet lms probe /dev/ttyUSB0\n"
           "  fusedet lms stream /dev/ttyUSB0 --baud 500000 --count 100\n"
           "  lms291-sim --link /tmp/lms & fusedet lms stream /tmp/lms --json --duration 2\n"
-          "  fusedet lms decode capture.bin | jq .values[180]");
+          "  fusedet lms stream /dev/ttyUSB0 --count 10 --record capture.bin && fusedet lms decode capture.bin\n"
+          "  fusedet lms decode capture.bin | jq .values[180]\n"
+          "Exit status: 0 on success; 1 on errors (printed as 'fusedet lms: error: ...') or when stream got no scan.\n"
+          "stream prints its counters to stderr at the end (scans, lost, CRC errors, resyncs, NAKs, timeouts, reconnects).");
       return [o, probe, stream, decode]() -> int {
         if (probe->parsed()) return runProbe(*o);
         if (stream->parsed()) return runStream(*o);

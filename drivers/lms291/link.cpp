@@ -7,6 +7,8 @@
 
 #include "fusedet/drivers/lms291/protocol.h"
 
+#include <spdlog/spdlog.h>
+
 namespace fusedet::drivers::lms291 {
 
 namespace {
@@ -88,6 +90,8 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
     // Line time of the request itself: at 9600 baud a long request takes tens of ms.
     const auto sendTime = std::chrono::microseconds(static_cast<std::int64_t>(byteSeconds(port_.baud()) * 1e6 * bytes.size()));
     if (auto w = port_.write(bytes, std::chrono::seconds(1) + sendTime); !w) return w.error();
+    spdlog::trace("lms291 {}: sent 0x{:02X} ({} bytes) at {} baud, attempt {}", port_.path(), command, bytes.size(),
+                  port_.baud(), attempt + 1);
     bool acked = false, nak = false;
     auto deadline = Clock::now() + o.ackTimeout + sendTime;
     for (;;) {
@@ -99,6 +103,8 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
         break;
       }
       const StreamEvent& e = **ev;
+      spdlog::trace("lms291 {}: event {} cmd 0x{:02X} at offset {}", port_.path(), static_cast<int>(e.kind),
+                    e.telegram.command, e.offset);
       if (e.kind == StreamEvent::Kind::kAckByte) {
         if (!acked) deadline = Clock::now() + o.replyTimeout;
         acked = true;

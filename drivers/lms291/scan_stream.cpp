@@ -82,6 +82,7 @@ void ScanStream::run() {
     auto lastScan = std::chrono::steady_clock::now();
     while (running_) {
       auto scan = device_.readScan(std::chrono::milliseconds(100));
+      if (!running_) break;  // stop() cancelled the read
       if (scan) {
         lastScan = std::chrono::steady_clock::now();
         onScan_(*scan);

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <thread>
 
 namespace fusedet::drivers {
 
@@ -97,10 +98,12 @@ Result<std::size_t> SerialPort::read(std::span<std::uint8_t> buffer, std::chrono
     if ((p.revents & (POLLIN | POLLHUP | POLLERR | POLLNVAL)) == 0) continue;
     const ssize_t n = ::read(fd_.get(), buffer.data(), buffer.size());
     if (n > 0) return static_cast<std::size_t>(n);
-    if (n == 0 || p.revents & (POLLHUP | POLLERR | POLLNVAL))
+    if (n < 0 && errno != EAGAIN && errno != EINTR) return lineError(errno, "read " + path_);
+    if (p.revents & (POLLHUP | POLLERR | POLLNVAL))
       return Error{std::make_error_code(std::errc::no_such_device), "read " + path_ + ": line hung up"};
-    if (errno == EAGAIN || errno == EINTR) continue;
-    return lineError(errno, "read " + path_);
+    // Raw mode with VMIN = VTIME = 0 reads 0 when the input vanished between poll and read
+    // (a flush, a speed change): not a hang-up. Pause briefly rather than spin on it.
+    if (n == 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
 }
 

@@ -44,6 +44,7 @@ int main(int argc, char** argv) {
   app.add_option("--room-half-width", o.scene.halfWidth, "side walls at x = +-W [m]")->capture_default_str();
   app.add_option("--room-depth", o.scene.depth, "front wall at y = D [m]")->capture_default_str();
   app.add_option("--post", post, "replace the posts by one at X Y RADIUS [m] (default 0.5 2.0 0.2)")->expected(3);
+  app.add_flag("--trace", o.trace, "log host reads (with the host's speed) and device speed changes to stderr");
   app.add_flag("--counter-beam", o.counterBeam, "beam 0 carries the sent-scan counter: 1000 + n mod 4000 (code units)");
   app.add_option("--flip-rate", o.faults.bitFlipRate, "probability per output byte of one flipped bit")->capture_default_str();
   app.add_option("--drop-rate", o.faults.dropRate, "probability per output byte of losing it")->capture_default_str();

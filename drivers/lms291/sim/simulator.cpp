@@ -79,6 +79,7 @@ void Simulator::destroyPty() {
 }
 
 void Simulator::setDeviceBaud(int baud) {
+  if (options_.trace) std::fprintf(stderr, "%s sim: device now at %d baud\n", Stamp::now().toString().c_str(), baud);
   baud_ = baud;
   if (!options_.attach.empty() && master_.valid()) {
     // Our side of a real line runs at the device's speed.
@@ -377,6 +378,9 @@ void Simulator::readHost(Clock::time_point now) {
     const ssize_t n = ::read(master_.get(), buf, sizeof buf);
     if (n <= 0) break;
     if (now < silentUntil_) continue;
+    if (options_.trace)
+      std::fprintf(stderr, "%s sim: %zd bytes from host at %d baud, device at %d\n", Stamp::now().toString().c_str(), n,
+                   hostBaud(), baud_);
     if (hostBaud() != baud_) {
       counters_.ignoredBytes += static_cast<std::uint64_t>(n);
       continue;
@@ -428,13 +432,16 @@ void Simulator::pumpOutput(Clock::time_point now) {
     }
     if (o.telegram) lineBytes_.insert(lineBytes_.end(), bytes.begin(), bytes.end());
     if (!bytes.empty()) {
-      if (hostBaud() == baud_) {
-        const ssize_t n = ::write(master_.get(), bytes.data(), bytes.size());
-        if (n < static_cast<ssize_t>(bytes.size())) counters_.undeliveredBytes += bytes.size() - static_cast<std::size_t>(std::max<ssize_t>(n, 0));
-      } else {
-        counters_.undeliveredBytes += bytes.size();
-      }
+      const int host = hostBaud();
+      ssize_t n = 0;
+      if (host == baud_) n = ::write(master_.get(), bytes.data(), bytes.size());
+      const std::size_t lost = bytes.size() - static_cast<std::size_t>(std::max<ssize_t>(n, 0));
+      counters_.undeliveredBytes += lost;
       counters_.bytesOut += bytes.size();
+      if (options_.trace && (outPos_ == 0 || lost > 0))
+        std::fprintf(stderr, "%s sim: %s 0x%02X at %d baud, host at %d%s\n", Stamp::now().toString().c_str(),
+                     outPos_ == 0 ? "start" : "cont.", o.bytes.size() > 4 ? o.bytes[4] : o.bytes[0], baud_, host,
+                     lost ? " - NOT DELIVERED" : "");
     }
     // A UART sends at a constant rate: if this thread woke late, catch up (within 2 ms).
     lineFreeAt_ = std::max(lineFreeAt_, now - std::chrono::milliseconds(2)) +

@@ -60,6 +60,7 @@ struct SimOptions {
   Faults faults;
   std::uint64_t seed = 1;
   std::chrono::microseconds replyDelay{2000};  // request received -> reply queued
+  bool trace = false;                  // one stderr line per host read and per device speed change
 };
 
 struct SimCounters {
