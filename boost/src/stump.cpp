@@ -32,11 +32,11 @@ void keepTop(std::vector<SplitCandidate>& top, const SplitCandidate& c, std::siz
   if (top.size() > k) top.pop_back();
 }
 
-// Adds weights[i] into hist[lane][bins[i]] for i in [begin, end).
+// Adds weights[i] into hist[i % 4][bins[i]] for i in [begin, end).
 inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t begin, std::size_t end,
                        float (*hist)[kBins]) {
   std::size_t i = begin;
-  for (; i + kLanes <= end; i += kLanes) {
+  for (; i + 4 <= end; i += 4) {
     hist[0][bins[i]] += w[i];
     hist[1][bins[i + 1]] += w[i + 1];
     hist[2][bins[i + 2]] += w[i + 2];
@@ -50,7 +50,7 @@ inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t beg
 inline void accumulatePair(const std::uint8_t* b0, const std::uint8_t* b1, const float* w, std::size_t begin,
                            std::size_t end, float (*h0)[kBins], float (*h1)[kBins]) {
   std::size_t i = begin;
-  for (; i + kLanes <= end; i += kLanes) {
+  for (; i + 4 <= end; i += 4) {
     const float w0 = w[i], w1 = w[i + 1], w2 = w[i + 2], w3 = w[i + 3];
     h0[0][b0[i]] += w0;
     h1[0][b1[i]] += w0;
@@ -67,30 +67,36 @@ inline void accumulatePair(const std::uint8_t* b0, const std::uint8_t* b1, const
   }
 }
 
-// Best split of one feature's histogram (pos/neg weight per bin), or gain -1 if none.
-SplitCandidate scanBins(std::size_t feature, const float (*pos)[kBins], const float (*neg)[kBins]) {
-  std::array<double, kBins> wp{}, wn{};
-  double totP = 0, totN = 0;
-  int last = -1;  // highest non-empty bin
+// Best split of one feature's histogram (pos/neg weight per bin), or gain -1 if none. Written as
+// separate array loops (merge lanes, prefix sums, gains, argmax) so that the compiler vectorises
+// the lane merge and the divisions; gains in float only rank candidates (the best are refined
+// exactly in double).
+// Leaves the histogram zeroed for the next feature.
+SplitCandidate scanBins(std::size_t feature, float (*pos)[kBins], float (*neg)[kBins]) {
+  alignas(64) float wp[kBins], wn[kBins], gain[kBins];
   for (int b = 0; b < kBins; ++b) {
-    wp[b] = double(pos[0][b]) + pos[1][b] + pos[2][b] + pos[3][b];
-    wn[b] = double(neg[0][b]) + neg[1][b] + neg[2][b] + neg[3][b];
-    totP += wp[b];
-    totN += wn[b];
-    if (wp[b] + wn[b] > 0) last = b;
+    wp[b] = (pos[0][b] + pos[1][b]) + (pos[2][b] + pos[3][b]);
+    wn[b] = (neg[0][b] + neg[1][b]) + (neg[2][b] + neg[3][b]);
+    for (int l = 0; l < kLanes; ++l) pos[l][b] = neg[l][b] = 0.f;
+  }
+  float cp = 0, cn = 0;
+  for (int b = 0; b < kBins; ++b) {  // prefix sums: weight left of the split after bin b
+    cp += wp[b];
+    cn += wn[b];
+    wp[b] = cp;
+    wn[b] = cn;
+  }
+  const float tot = cp + cn, totS = cp - cn;
+  for (int b = 0; b < kBins; ++b) {
+    const float wl = wp[b] + wn[b], wr = tot - wl;
+    const float sl = wp[b] - wn[b], sr = totS - sl;
+    // A side below a millionth of the total weight counts as empty (float prefix sums).
+    const bool ok = wl > 1e-6f * tot && wr > 1e-6f * tot;
+    gain[b] = ok ? sl * sl / (ok ? wl : 1.f) + sr * sr / (ok ? wr : 1.f) : -1.f;
   }
   SplitCandidate best{feature, 0, -1};
-  double lp = 0, ln = 0;
-  const double tot = totP + totN, totS = totP - totN;
-  for (int b = 0; b < last; ++b) {
-    lp += wp[b];
-    ln += wn[b];
-    const double wl = lp + ln, wr = tot - wl;
-    if (wl <= 0 || wr <= 0) continue;
-    const double sl = lp - ln, sr = totS - sl;
-    const double gain = sl * sl / wl + sr * sr / wr;
-    if (gain > best.gain) best = {feature, b, gain};
-  }
+  for (int b = 0; b < kBins - 1; ++b)
+    if (gain[b] > best.gain) best = {feature, b, double(gain[b])};
   return best;
 }
 
@@ -114,13 +120,13 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         alignas(64) float pos[2][kLanes][kBins];
                         alignas(64) float neg[2][kLanes][kBins];
+                        std::memset(pos, 0, sizeof pos);  // scanBins() re-zeroes what it reads
+                        std::memset(neg, 0, sizeof neg);
                         for (std::size_t c = r.begin(); c != r.end(); ++c) {
                           std::vector<SplitCandidate> top;
                           const std::size_t end = std::min(m.features(), (c + 1) * kChunk);
                           std::size_t f = c * kChunk;
                           for (; f + 1 < end; f += 2) {
-                            std::memset(pos, 0, sizeof pos);
-                            std::memset(neg, 0, sizeof neg);
                             const std::uint8_t *b0 = m.row(f), *b1 = m.row(f + 1);
                             accumulatePair(b0, b1, weights.data(), 0, positives, pos[0], pos[1]);
                             accumulatePair(b0, b1, weights.data(), positives, n, neg[0], neg[1]);
@@ -130,8 +136,6 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
                             }
                           }
                           if (f < end) {
-                            std::memset(pos, 0, sizeof pos);
-                            std::memset(neg, 0, sizeof neg);
                             accumulate(m.row(f), weights.data(), 0, positives, pos[0]);
                             accumulate(m.row(f), weights.data(), positives, n, neg[0]);
                             const SplitCandidate s = scanBins(f, pos[0], neg[0]);
