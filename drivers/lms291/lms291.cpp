@@ -172,10 +172,7 @@ Result<void> Lms291::writeConfig(const ConfigBlock& config) {
 }
 
 Result<void> Lms291::setVariant(Variant v) {
-  std::vector<std::uint8_t> data;
-  putU16(data, static_cast<std::uint16_t>(v.angleDeg));
-  putU16(data, static_cast<std::uint16_t>(v.resolutionCdeg));
-  auto t = link_.request(static_cast<std::uint8_t>(Command::kSetVariant), data, options(config_.replyTimeout));
+  auto t = link_.request(static_cast<std::uint8_t>(Command::kSetVariant), variantPayload(v), options(config_.replyTimeout));
   if (!t) return t.error();
   if (t->data.size() < 5 || t->data[0] != 1)
     return protocolError("variant " + std::to_string(v.angleDeg) + "/" + std::to_string(v.resolutionCdeg) +

@@ -52,6 +52,13 @@ bool Variant::valid() const {
   return false;
 }
 
+std::vector<std::uint8_t> variantPayload(Variant v) {
+  std::vector<std::uint8_t> data;
+  putU16(data, static_cast<std::uint16_t>(v.angleDeg));
+  putU16(data, static_cast<std::uint16_t>(v.resolutionCdeg));
+  return data;
+}
+
 int distanceBits(std::uint8_t measuringMode) {
   switch (measuringMode) {
     case 0x03: case 0x04: return 14;              // 16 m

@@ -56,6 +56,23 @@ TEST(LmsProtocol, TelegramSizesPerVariant) {
   EXPECT_EQ((Variant{100, 25}.startDeg()), 40.0);
 }
 
+TEST(LmsProtocol, VariantRequestsMatchTheFactSheet) {
+  // §3: angle 100/180 = 64 00 / B4 00; resolution 25/50/100 = 19 00 / 32 00 / 64 00; §1 vectors.
+  EXPECT_EQ(variantPayload({100, 100}), (std::vector<std::uint8_t>{0x64, 0x00, 0x64, 0x00}));
+  EXPECT_EQ(encodeRequest(0x3B, variantPayload({180, 50})),
+            (std::vector<std::uint8_t>{0x02, 0x00, 0x05, 0x00, 0x3B, 0xB4, 0x00, 0x32, 0x00, 0x3B, 0x1F}));
+  EXPECT_EQ(encodeRequest(0x3B, variantPayload({100, 25})),
+            (std::vector<std::uint8_t>{0x02, 0x00, 0x05, 0x00, 0x3B, 0x64, 0x00, 0x19, 0x00, 0xE7, 0x72}));
+  // Valid variants and their beam counts (§3): 181, 361, 101, 201, 401; 180/0.25 rejected.
+  EXPECT_EQ((Variant{180, 100}.beams()), 181);
+  EXPECT_EQ((Variant{180, 50}.beams()), 361);
+  EXPECT_EQ((Variant{100, 100}.beams()), 101);
+  EXPECT_EQ((Variant{100, 50}.beams()), 201);
+  EXPECT_EQ((Variant{100, 25}.beams()), 401);
+  EXPECT_FALSE((Variant{180, 25}.valid()));
+  EXPECT_FALSE((Variant{90, 50}.valid()));
+}
+
 TEST(LmsProtocol, CountWordBits) {
   // bits 0-9 count, 11-12 partial index, 13 partial, 14-15 unit (01 = mm).
   const CountWord c = CountWord::decode(0x4169);  // 0100 0001 0110 1001: mm, count 361

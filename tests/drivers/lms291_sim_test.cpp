@@ -513,6 +513,31 @@ TEST_F(LmsSim, InterlacedHalfDegreeUnderCorruptionDropsOnlyBrokenGroups) {
   EXPECT_TRUE(lms.stop());
 }
 
+TEST_F(LmsSim, OutputIsPacedAtTheLineRate) {
+  // 38400 baud, 361 beams: a 732-byte scan takes 190.6 ms on the line; the device sends a new
+  // scan at the first full scan (2 rotations, 26.7 ms) after the line is free: every 8th pair
+  // of rotations -> 213.3 ms, 4.69 scans/s (PLY documents ~5 Hz at 38400).
+  sim::SimOptions o;
+  startSim(o);
+  Lms291 lms(config(38400));
+  ASSERT_TRUE(lms.start());
+  ASSERT_TRUE(lms.readScan(1000ms));
+  auto first = lms.readScan(1000ms);
+  ASSERT_TRUE(first);
+  int n = 0;
+  fusedet::Stamp last;
+  while (n < 12) {
+    auto s = lms.readScan(1000ms);
+    ASSERT_TRUE(s);
+    last = s->stamp;
+    ++n;
+  }
+  const double periodMs = double(last - first->stamp) * 1e-6 / n;
+  std::printf("38400 baud, 361 beams: one scan every %.1f ms (%.2f scans/s)\n", periodMs, 1000.0 / periodMs);
+  EXPECT_NEAR(periodMs, 8 * 2 * 1000.0 / 75, 5.0);
+  EXPECT_TRUE(lms.stop());
+}
+
 TEST_F(LmsSim, Termios2PathAt500k) {
   sim::SimOptions o;
   startSim(o);

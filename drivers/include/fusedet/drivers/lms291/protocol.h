@@ -81,6 +81,9 @@ struct Variant {
   auto operator<=>(const Variant&) const = default;
 };
 
+// 0x3B request data: angle u16, resolution u16 (e.g. B4 00 32 00 = 180 deg / 0.5 deg).
+std::vector<std::uint8_t> variantPayload(Variant v);
+
 // Measuring modes (config byte 5, §3) and the value bits they use (§4).
 inline constexpr std::uint8_t kMeasuring8m = 0x00;    // 8/80 m, flags in bits 13-15
 inline constexpr std::uint8_t kMeasuring32m = 0x06;   // 32 m + field A
