@@ -1,6 +1,7 @@
 #include "fusedet/fusion/camera_layers.h"
 
 #include <algorithm>
+#include <array>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -9,7 +10,13 @@ namespace fusedet::fusion {
 cv::Mat hueDegrees(const cv::Mat& bgr) {
   if (bgr.type() != CV_8UC3) throw std::invalid_argument("hueDegrees: image must be 8-bit BGR");
   cv::Mat hue(bgr.size(), CV_32FC1);
-  // One pass with one division per pixel; cv::cvtColor would first need a float copy of the image.
+  // One pass, no division: 60 / (max - min) from a table of the 255 possible differences.
+  // cv::cvtColor would first need a float copy of the whole image.
+  static const std::array<float, 256> kSixtyOver = [] {
+    std::array<float, 256> t{};
+    for (int d = 1; d < 256; ++d) t[static_cast<std::size_t>(d)] = 60.f / static_cast<float>(d);
+    return t;
+  }();
   for (int y = 0; y < bgr.rows; ++y) {
     const std::uint8_t* p = bgr.ptr<std::uint8_t>(y);
     float* h = hue.ptr<float>(y);
@@ -21,7 +28,7 @@ cv::Mat hueDegrees(const cv::Mat& bgr) {
         h[x] = 0.f;
         continue;
       }
-      const float k = 60.f / static_cast<float>(diff);
+      const float k = kSixtyOver[static_cast<std::size_t>(diff)];
       float v;
       if (mx == r)
         v = static_cast<float>(g - b) * k;
