@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <thread>
@@ -82,12 +83,13 @@ void Lms291::close() {
 Result<int> Lms291::detectBaud() {
   // The configured speed first (a restart after a crash finds the device there), then the
   // power-on speed, then the rest.
-  std::vector<int> order{config_.baud, 9600};
-  for (int b : kBauds) order.push_back(b);
-  std::vector<int> tried;
+  std::vector<int> once{config_.baud, 9600};
+  for (int b : kBauds)
+    if (std::find(once.begin(), once.end(), b) == once.end()) once.push_back(b);
+  // Two rounds: a device busy with something else (a reset, a long reply) gets a second chance.
+  std::vector<int> order = once;
+  order.insert(order.end(), once.begin(), once.end());
   for (int b : order) {
-    if (std::find(tried.begin(), tried.end(), b) != tried.end()) continue;
-    tried.push_back(b);
     if (auto r = link_.setBaud(b); !r) return r.error();
     RequestOptions o;
     // A device that streams at this speed answers after the telegram in flight.

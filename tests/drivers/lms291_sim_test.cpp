@@ -337,8 +337,8 @@ TEST_F(LmsSim, VanishAndReappearRecoversWithinTwoSeconds) {
   }
   const double recovery = std::chrono::duration<double>(firstAfter - reappeared).count();
   const auto k = stream.counters();
-  std::printf("vanish 0.5 s: first scan %.3f s after the port came back (%llu reconnects, %llu failed inits)\n",
-              recovery, (unsigned long long)k.reconnects, (unsigned long long)k.failedInits);
+  std::printf("vanish 0.5 s: first scan %.3f s after the port came back (%llu reconnects, %llu failed inits; last: %s)\n",
+              recovery, (unsigned long long)k.reconnects, (unsigned long long)k.failedInits, k.lastError.c_str());
   EXPECT_LT(recovery, 2.0);
   EXPECT_EQ(k.reconnects, 1u);
   EXPECT_EQ(sim_->counters().vanishes, 1u);
@@ -405,8 +405,8 @@ TEST_F(LmsSim, StopDuringASlowInitIsPrompt) {
   (void)stream.stop();
   const double took = std::chrono::duration<double>(Clock::now() - t0).count();
   // The init is cut short at once; the stop sequence (streaming off, 9600) then gives up on the
-  // silent device after one retry of 100 ms each.
-  EXPECT_LT(took, 0.6) << "stop() waited for the init";
+  // silent device after one retry of 100 ms each (a full init could take ~10 s).
+  EXPECT_LT(took, 1.0) << "stop() waited for the init";
   EXPECT_EQ(stream.state(), StreamState::kStopped);
 }
 
@@ -534,7 +534,7 @@ TEST_F(LmsSim, OutputIsPacedAtTheLineRate) {
   }
   const double periodMs = double(last - first->stamp) * 1e-6 / n;
   std::printf("38400 baud, 361 beams: one scan every %.1f ms (%.2f scans/s)\n", periodMs, 1000.0 / periodMs);
-  EXPECT_NEAR(periodMs, 8 * 2 * 1000.0 / 75, 5.0);
+  EXPECT_NEAR(periodMs, 8 * 2 * 1000.0 / 75, 12.0);  // 7 or 9 rotation pairs would be 187 or 240 ms
   EXPECT_TRUE(lms.stop());
 }
 
