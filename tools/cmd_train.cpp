@@ -89,11 +89,14 @@ class ConsoleProgress final : public boosting::ProgressSink {
         found_ = e.negatives;
         scanned_ = e.windowsScanned;
         cascadeFa_ = e.cascadeFalseAlarm;
-        if (!tty_)
+        if (e.stage > e.maxStages) {  // the scan after the last stage only measures the cascade
+          if (tty_) status(e, "final false-alarm scan");
+        } else if (!tty_) {
           std::fprintf(stderr, "stage %d: %zu negatives found in %zu windows (cascade false-alarm rate %.3g)\n",
                        e.stage, e.negatives, e.windowsScanned, e.cascadeFalseAlarm);
-        else
+        } else {
           status(e, "bootstrapping");
+        }
         break;
       case ProgressKind::kStageStart:
         positives_ = e.positives;
@@ -128,7 +131,7 @@ class ConsoleProgress final : public boosting::ProgressSink {
     std::fprintf(stderr,
                  "\r\033[Kstage %d/%d  round %d/%d  hit %.4f  false alarms %.4f  positives %zu  negatives %zu "
                  "(of %zu windows)  %s  elapsed %s  ETA %s",
-                 e.stage, e.maxStages, e.round, e.maxRounds, e.hitRate, e.falseAlarm, positives_, found_, scanned_,
+                 std::min(e.stage, e.maxStages), e.maxStages, e.round, e.maxRounds, e.hitRate, e.falseAlarm, positives_, found_, scanned_,
                  phase, clock(e.elapsedSeconds).c_str(), eta(e).c_str());
     std::fflush(stderr);
   }
