@@ -1,5 +1,6 @@
 // fusedet: the command line of the fusedet perception system (see `fusedet --help`).
 
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -51,6 +52,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  // Logs go to stderr so that machine-readable output on stdout (--json, NDJSON) stays clean.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("fusedet"));
   spdlog::set_level(spdlog::level::from_str(logLevel));
   for (auto& [sub, run] : runners) {
     if (!sub->parsed()) continue;
