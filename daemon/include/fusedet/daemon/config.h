@@ -62,7 +62,7 @@ struct Config {
   } fusion;
 
   struct Detection {
-    std::vector<std::string> models{"/usr/share/fusedet/models/car.yaml"};
+    std::vector<std::string> models{"/usr/share/fusedet/models/car.json"};
     double scaleFactor = 1.1;
     std::array<int, 2> minSize{24, 24};
     std::array<int, 2> maxSize{0, 0};
