@@ -94,6 +94,7 @@ struct Args {
   std::size_t features = 162336, samples = 3000;
   int threads = 2, rounds = 5;
   bool skipMlBoost = false;
+  bool oursOnly = false;  // tuning: no peers, no headline ratios
   std::string source = "kitti";
   std::size_t maxFrames = 0;
   std::size_t xgBatch = 3000;  // rows per iterator batch of XGBoost's QuantileDMatrix
@@ -127,12 +128,14 @@ Args parse(int argc, char** argv) {
       a.xgBatch = std::stoul(next());
     } else if (s == "--xgb-build-threads") {
       a.xgBuildThreads = std::stoi(next());
+    } else if (s == "--ours-only") {
+      a.oursOnly = true;
     } else if (s == "--skip-mlboost") {
       a.skipMlBoost = true;
     } else if (s == "--help" || s == "-h") {
       std::printf(
           "boost_round_bench [--smoke] [--features N] [--samples N] [--threads T] [--rounds R]\n"
-          "                  [--source kitti|synthetic] [--skip-mlboost]\n"
+          "                  [--source kitti|synthetic] [--skip-mlboost] [--ours-only]\n"
           "--source kitti (default): OpenCV's default pool (24-unit grid, types a-e) on intensity windows\n"
           "of the shared KITTI drives; synthetic: a generated matrix. --smoke: 3000 x 400, 3 frames/drive.\n"
           "One boosting round, ours vs XGBoost (hist) vs cv::ml::Boost, same matrix and threads.\n"
@@ -191,6 +194,21 @@ int main(int argc, char** argv) try {
   };
   fusedet::boosting::StumpSearchOptions opt;
   opt.threads = a.threads;
+
+  if (a.oursOnly) {
+    std::vector<double> t;
+    for (int r = 0; r < a.rounds; ++r) {
+      t0 = Clock::now();
+      const auto st = fusedet::boosting::findBestStump(m, P, w, raw, opt);
+      t.push_back(since(t0));
+      if (r == 0) std::printf("ours: feature %zu error %.6f\n", st.feature, st.error);
+    }
+    for (double x : t) std::printf("%.3f ", x);
+    std::printf("\n");
+    std::sort(t.begin(), t.end());
+    std::printf("ours: round %.4f s (median of %d, min %.4f)\n", t[t.size() / 2], a.rounds, t.front());
+    return 0;
+  }
 
   // ---- XGBoost: setup ----
   // QuantileDMatrix fed by an iterator over row batches (XGBoost's path for hist that keeps no CSR
