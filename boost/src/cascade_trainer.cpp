@@ -226,6 +226,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     sr.cascadeFalseAlarm = cascadeFa;
     sr.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
     sr.harvestSeconds = harvestSeconds;
+    sr.matrixBytes = matrix.bytes();
     sr.matrixSeconds = matrixSeconds;
     sr.boostSeconds = std::chrono::duration<double>(Clock::now() - tb).count();
     report.stages.push_back(sr);
@@ -241,7 +242,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                  std::to_string(harvest.candidates) + " candidates in " +
                  std::to_string(harvest.windowsScanned) + " windows, " + fixed(sr.seconds, 1) + " s (scan " +
                  fixed(sr.harvestSeconds, 1) + ", features " + fixed(sr.matrixSeconds, 1) + ", boosting " +
-                 fixed(sr.boostSeconds, 1) + ")";
+                 fixed(sr.boostSeconds, 1) + "), matrix " + fixed(double(sr.matrixBytes) / 1e6, 0) + " MB";
     progress.onProgress(ev);
   }
 

@@ -57,6 +57,7 @@ struct StageReport {
   double seconds = 0;
   // Where the time went: bootstrapping scan, pool evaluation + binning, boosting rounds.
   double harvestSeconds = 0, matrixSeconds = 0, boostSeconds = 0;
+  std::size_t matrixBytes = 0;  // the stage's 8-bit feature matrix (pool x samples)
 };
 
 struct TrainingReport {
