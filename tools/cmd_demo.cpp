@@ -1,8 +1,10 @@
 // fusedet demo: the main job on its embedded default - the most complete pipeline that exists,
 // run on the real KITTI frames in ../shared/data: read a frame, fuse it into a layer stack
-// (fusion/), print the stack and the labels.
+// (fusion/), print the stack and the labels, and detect with the bundled models (boost/).
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -10,6 +12,9 @@
 
 #include "command.h"
 #include "data_dir.h"
+#include "fusedet/boost/detector.h"
+#include "fusedet/boost/grouping.h"
+#include "fusedet/boost/model_io.h"
 #include "fusedet/core/layer_stack.h"
 #include "fusedet/fusion/kitti.h"
 #include "fusedet/fusion/projection.h"
@@ -20,8 +25,59 @@ namespace {
 struct DemoOptions {
   std::filesystem::path data = defaultDataDir();
   std::string drive = "kitti";
-  std::string frame;  // empty = first frame of the drive
+  std::string frame;  // empty = the first held-back test frame of the drive
+  std::filesystem::path models = "models";  // one model file per class (*.json)
+  int threads = 0;
 };
+
+// The frames the bundled models were not trained on: the last third of each drive, the split
+// `fusedet experiments` and `scripts/train-models` use.
+std::size_t firstTestFrame(std::size_t frames) {
+  return static_cast<std::size_t>(std::lround(static_cast<double>(frames) * 2.0 / 3.0));
+}
+
+// Detects with every model in `dir` and prints each detection with its best-matching label.
+void detectWithModels(const std::filesystem::path& dir, const LayerStack& stack, const Labels& labels,
+                      int threads) {
+  std::vector<std::filesystem::path> files;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  if (ec || files.empty())
+    throw std::runtime_error(dir.string() + ": no model files (*.json); set --models");
+  std::sort(files.begin(), files.end());
+  // The settings the bundled models were evaluated with (docs/results/report.md).
+  boosting::ScanParams scan;
+  scan.scaleFactor = 1.1;
+  scan.step = 2;
+  scan.threads = threads;
+  boosting::GroupParams group;
+  group.method = boosting::GroupParams::Method::kOpenCv;
+  group.minNeighbors = 3;
+  for (const auto& file : files) {
+    const boosting::Detector detector(boosting::loadModel(file));
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::vector<Detection> found = boosting::detect(detector, stack, scan, group);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const auto& c = detector.cascade();
+    std::printf("detect    %-7s %s: %zu stages, %zu detections in %.1f ms\n", c.className.c_str(),
+                file.filename().string().c_str(), c.stages.size(), found.size(), ms);
+    for (const Detection& d : found) {
+      double best = 0;
+      const Label* match = nullptr;
+      for (const Label& l : labels) {
+        const double v = iou(d.box, l.box);
+        if (v > best) best = v, match = &l;
+      }
+      std::printf("  %-7s score=%7.3f box x=%.1f y=%.1f w=%.1f h=%.1f", d.className.c_str(), d.score, d.box.x,
+                  d.box.y, d.box.w, d.box.h);
+      if (match && best >= 0.5)
+        std::printf("  matches %s label (IoU %.2f)\n", match->sourceClass.c_str(), best);
+      else
+        std::printf("  no label with IoU >= 0.5\n");
+    }
+  }
+}
 
 int runDemo(const DemoOptions& o) {
   const auto root = o.data / o.drive;
@@ -29,7 +85,7 @@ int runDemo(const DemoOptions& o) {
     throw std::runtime_error(root.string() + ": no such data directory (set --data or FUSEDET_DATA)");
   const auto ids = fusion::listKittiFrames(root);
   if (ids.empty()) throw std::runtime_error(root.string() + ": no frames");
-  const std::string id = o.frame.empty() ? ids.front() : o.frame;
+  const std::string id = o.frame.empty() ? ids[std::min(firstTestFrame(ids.size()), ids.size() - 1)] : o.frame;
   const fusion::KittiFrame f = fusion::readKittiFrame(root, id);
 
   std::printf("fusedet demo: KITTI %s frame %s (%zu frames in drive)\n", o.drive.c_str(), id.c_str(),
@@ -90,22 +146,32 @@ int runDemo(const DemoOptions& o) {
     if (!l.ignore)
       std::printf("  %-7s box x=%.1f y=%.1f w=%.1f h=%.1f occlusion=%d\n", l.className.c_str(), l.box.x,
                   l.box.y, l.box.w, l.box.h, l.occlusion);
+  if (!o.models.empty()) detectWithModels(o.models, stack, f.labels, o.threads);
   return 0;
 }
 
 const bool registered = registerCommand(
     "demo",
-    "Fuse one real KITTI frame into a layer stack and print the stack and its labels",
+    "Fuse one real KITTI frame into a layer stack, print it and detect with the bundled models",
     [](CLI::App& app) {
       auto o = std::make_shared<DemoOptions>();
       app.add_option("--data", o->data, "root of the shared data (kitti/, kitti_0009/, ...)")
           ->capture_default_str();
       app.add_option("--drive", o->drive, "drive directory under --data")->capture_default_str();
-      app.add_option("--frame", o->frame, "frame id, e.g. 000042 (default: the first)");
+      app.add_option("--frame", o->frame,
+                     "frame id, e.g. 000042 (default: the first frame of the drive's held-back last third)");
+      app.add_option("--models", o->models,
+                     "directory of model files (*.json) to detect with; empty string = fuse only")
+          ->capture_default_str();
+      app.add_option("--threads", o->threads, "detection threads; 0 = all cores")->capture_default_str();
       app.footer(
           "Reads image_2, velodyne, calib and label_2 of one frame, fuses it (camera layers red, green,\n"
           "blue, intensity, hue at image size; distance and remission at half size with a validity\n"
-          "mask) and prints each layer's size, type, valid share and value range, then the labels.\n\n"
+          "mask) and prints each layer's size, type, valid share and value range, then the labels.\n"
+          "Then runs every model in --models (the bundled models/<class>.json by default) on the stack\n"
+          "(scale factor 1.1, step 2, OpenCV grouping with 3 neighbours, as in docs/results) and prints\n"
+          "each detection with the label it matches (IoU >= 0.5), if any. The default frame is one the\n"
+          "bundled models were not trained on.\n\n"
           "Examples:\n"
           "  fusedet demo\n"
           "  fusedet demo --drive kitti_0009 --frame 000004\n"
