@@ -25,6 +25,8 @@
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/opencv_cascade.h"
 
+#include "headline_reporter.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -178,18 +180,6 @@ void BM_Ours_7Layer_IntegralsOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_Ours_7Layer_IntegralsOnly)->Unit(benchmark::kMillisecond);
 
-class HeadlineReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration) {
-        ms[r.benchmark_name()] = r.GetAdjustedRealTime();
-        cpuMs[r.benchmark_name()] = r.GetAdjustedCPUTime();
-      }
-  }
-  std::map<std::string, double> ms, cpuMs;
-};
 
 // Fraction of windows on which both detectors decide the same (raw candidates, same images).
 double windowAgreement(std::size_t& windows, std::size_t& differ) {
@@ -216,16 +206,16 @@ double windowAgreement(std::size_t& windows, std::size_t& differ) {
 int main(int argc, char** argv) {
   cv::setNumThreads(1);
   benchmark::Initialize(&argc, argv);
-  HeadlineReporter reporter;
+  fusedet::bench::HeadlineReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   // Both sides run on one thread, so CPU time is their work; it is also robust against other
   // processes sharing the machine (wall-clock ratio printed beside it).
-  const double ours = reporter.cpuMs["BM_Ours_FrontalFaceDefault_640x480"];
-  const double cv = reporter.cpuMs["BM_OpenCv_FrontalFaceDefault_640x480"];
-  const double ours7 = reporter.cpuMs["BM_Ours_7Layer_Kitti_1242x375"];
-  const double integrals7 = reporter.cpuMs["BM_Ours_7Layer_IntegralsOnly"];
-  const double oursWall = reporter.ms["BM_Ours_FrontalFaceDefault_640x480"];
-  const double cvWall = reporter.ms["BM_OpenCv_FrontalFaceDefault_640x480"];
+  const double ours = reporter.cpu["BM_Ours_FrontalFaceDefault_640x480"];
+  const double cv = reporter.cpu["BM_OpenCv_FrontalFaceDefault_640x480"];
+  const double ours7 = reporter.cpu["BM_Ours_7Layer_Kitti_1242x375"];
+  const double integrals7 = reporter.cpu["BM_Ours_7Layer_IntegralsOnly"];
+  const double oursWall = reporter.wall["BM_Ours_FrontalFaceDefault_640x480"];
+  const double cvWall = reporter.wall["BM_OpenCv_FrontalFaceDefault_640x480"];
   const Work& w = gWork["ours"];
   const Work& w7 = gWork["ours7"];
   const std::size_t images = fixture().gray.size();

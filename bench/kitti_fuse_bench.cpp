@@ -20,6 +20,8 @@
 #include "fusedet/fusion/camera_layers.h"
 #include "fusedet/fusion/kitti.h"
 
+#include "headline_reporter.h"
+
 namespace {
 using namespace fusedet;
 using namespace fusedet::fusion;
@@ -141,18 +143,6 @@ void BM_OpenCvPipeline(benchmark::State& state) {
 }
 BENCHMARK(BM_OpenCvPipeline)->Unit(benchmark::kMillisecond);
 
-class HeadlineReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration) {
-        cpu[r.benchmark_name()] = r.GetAdjustedCPUTime();
-        wall[r.benchmark_name()] = r.GetAdjustedRealTime();
-      }
-  }
-  std::map<std::string, double> cpu, wall;
-};
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -160,7 +150,7 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   std::printf("frame %s: %zu points, image %dx%d, laser layers at half size, 1 thread\n", frame().id.c_str(),
               frame().points.size(), frame().image.cols, frame().image.rows);
-  HeadlineReporter reporter;
+  fusedet::bench::HeadlineReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   std::printf("undistortion is the identity for KITTI (rectified images); see kitti_fuse_with_undistortion_ms\n");
   std::printf("bench: kitti_fuse_step_undistort_ms 0.000\n");

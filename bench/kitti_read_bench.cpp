@@ -10,6 +10,8 @@
 
 #include "fusedet/fusion/kitti.h"
 
+#include "headline_reporter.h"
+
 namespace {
 const std::filesystem::path kRoot = std::filesystem::path(FUSEDET_DATA_DIR) / "kitti";
 
@@ -24,23 +26,13 @@ void BM_OpenCvImreadOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_OpenCvImreadOnly)->Unit(benchmark::kMillisecond);
 
-// Collects each benchmark's mean time so main() can print the headline lines.
-class HeadlineReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const Run& r : runs)
-      if (r.run_type == Run::RT_Iteration) ms[r.benchmark_name()] = r.GetAdjustedRealTime();
-  }
-  std::map<std::string, double> ms;
-};
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  HeadlineReporter reporter;
+  fusedet::bench::HeadlineReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const double ours = reporter.ms["BM_ReadKittiFrame"], png = reporter.ms["BM_OpenCvImreadOnly"];
+  const double ours = reporter.wall["BM_ReadKittiFrame"], png = reporter.wall["BM_OpenCvImreadOnly"];
   std::printf("bench: kitti_read_ms %.3f\n", ours);
   std::printf("bench: kitti_read_vs_png_decode %.3f\n", png > 0 ? ours / png : 0.0);
   return 0;
