@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <filesystem>
+
 namespace fusedet::drivers::lms291 {
 
 std::string_view toString(StreamState s) {
@@ -49,6 +51,13 @@ bool ScanStream::sleepFor(std::chrono::milliseconds d) {
   return running_.load();
 }
 
+bool ScanStream::waitForDevice(const std::string& path) {
+  std::error_code ec;
+  while (!std::filesystem::exists(path, ec))
+    if (!sleepFor(kDevicePoll)) return false;
+  return running_.load();
+}
+
 void ScanStream::run() {
   const std::string& dev = device_.config().device;
   const auto kBackoffMin = std::chrono::milliseconds(50);
@@ -66,8 +75,15 @@ void ScanStream::run() {
         counters_.lastError = info.error().message();
         counters_.device = device_.counters();
       }
-      spdlog::debug("lms291 {}: init failed ({}), retrying in {} ms", dev, info.error().message(), backoff.count());
       state_ = StreamState::kBackingOff;
+      if (info.error().code == std::errc::no_such_file_or_directory) {
+        // The device node is gone (adapter unplugged): watching for it costs a stat, not an init,
+        // so poll it briskly instead of backing off; a replugged device is initialised at once.
+        spdlog::debug("lms291 {}: {}; waiting for the device to reappear", dev, info.error().message());
+        if (!waitForDevice(dev)) break;
+        continue;
+      }
+      spdlog::debug("lms291 {}: init failed ({}), retrying in {} ms", dev, info.error().message(), backoff.count());
       if (!sleepFor(backoff)) break;
       backoff = std::min(backoff * 2, reconnectMax_);
       continue;

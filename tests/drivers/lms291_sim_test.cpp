@@ -154,7 +154,10 @@ TEST_F(LmsSim, Streams1000ScansNoneLostOrDuplicated) {
     ASSERT_EQ(s->size(), 181u);
     const long n = counterOf(*s);
     if (previous >= 0) {
-      ASSERT_EQ(n, previous + 1) << "scan " << i << ": lost or duplicated";
+      // Every scan the simulator queued must arrive: it counts what it could not deliver.
+      ASSERT_EQ(n, previous + 1) << "scan " << i << ": lost or duplicated; driver: " << lms.counters().link.reader.expired
+                                 << " frames expired, " << lms.counters().link.reader.resyncs << " resyncs; simulator: "
+                                 << sim_->counters().overrunBytes << " overrun bytes";
       ASSERT_EQ(s->sequence, previousSeq + 1);
       ASSERT_GT(s->stamp, previousStamp);
     }
@@ -164,21 +167,27 @@ TEST_F(LmsSim, Streams1000ScansNoneLostOrDuplicated) {
     previousStamp = s->stamp;
     if (i == 0) {
       firstStamp = s->stamp;
-      skipped0 = sim_->counters().scansSkipped;
+      skipped0 = sim_->counters().scansSkipped + sim_->counters().scansStalled;
     }
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   // 75 Hz mirror: stamps 13.33 ms apart on average, plus the rotations whose scan the device
   // skipped because the line was still busy (single intervals jitter with the load).
-  const double skipped = double(sim_->counters().scansSkipped - skipped0);
+  const auto sc = sim_->counters();
+  const double skipped = double(sc.scansSkipped + sc.scansStalled - skipped0);
   const double meanMs = double(previousStamp - firstStamp) * 1e-6 / 999.0;
   EXPECT_NEAR(meanMs, 1000.0 / 75 * (1000.0 + skipped) / 1000.0, 0.3) << skipped << " scans skipped";
   const auto k = lms.counters();
-  std::printf("1000 scans at 500000 baud in %.2f s, mean stamp interval %.3f ms; lost %llu, CRC errors %llu, resyncs %llu\n", seconds, meanMs,
-              (unsigned long long)k.lostScans, (unsigned long long)k.link.reader.crcErrors,
-              (unsigned long long)k.link.reader.resyncs);
+  std::printf(
+      "1000 scans at 500000 baud in %.2f s, mean stamp interval %.3f ms; lost %llu, CRC errors %llu, resyncs %llu, "
+      "expired frames %llu; simulator skipped %llu, stalled %llu, overrun bytes %llu\n",
+      seconds, meanMs, (unsigned long long)k.lostScans, (unsigned long long)k.link.reader.crcErrors,
+      (unsigned long long)k.link.reader.resyncs, (unsigned long long)k.link.reader.expired,
+      (unsigned long long)sc.scansSkipped, (unsigned long long)sc.scansStalled, (unsigned long long)sc.overrunBytes);
   EXPECT_EQ(k.lostScans, 0u);
   EXPECT_EQ(k.link.reader.crcErrors, 0u);
+  EXPECT_EQ(k.link.reader.expired, 0u) << "a telegram arrived with a gap inside";
+  EXPECT_EQ(sc.overrunBytes, 0u);
   EXPECT_EQ(k.badScans, 0u);
   EXPECT_TRUE(lms.stop());
 }

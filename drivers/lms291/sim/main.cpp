@@ -122,13 +122,13 @@ int main(int argc, char** argv) {
   device.stop();
   const sim::SimCounters c = device.counters();
   std::printf(
-      "{\"baud\":%d,\"mode\":%d,\"bytes_out\":%llu,\"telegrams_out\":%llu,\"scans_out\":%llu,\"scans_skipped\":%llu,"
+      "{\"baud\":%d,\"mode\":%d,\"bytes_out\":%llu,\"telegrams_out\":%llu,\"scans_out\":%llu,\"scans_skipped\":%llu,\"scans_stalled\":%llu,"
       "\"telegrams_damaged\":%llu,\"bit_flips\":%llu,\"dropped_bytes\":%llu,\"garbage_bytes\":%llu,\"requests\":%llu,"
-      "\"bad_requests\":%llu,\"naks_injected\":%llu,\"ignored_bytes\":%llu,\"vanishes\":%llu,\"power_ons\":%llu}\n",
+      "\"bad_requests\":%llu,\"naks_injected\":%llu,\"ignored_bytes\":%llu,\"undelivered_bytes\":%llu,\"overrun_bytes\":%llu,\"vanishes\":%llu,\"power_ons\":%llu}\n",
       s.baud, s.mode, (unsigned long long)c.bytesOut, (unsigned long long)c.telegramsOut, (unsigned long long)c.scansOut,
-      (unsigned long long)c.scansSkipped, (unsigned long long)c.telegramsDamaged, (unsigned long long)c.bitFlips,
+      (unsigned long long)c.scansSkipped, (unsigned long long)c.scansStalled, (unsigned long long)c.telegramsDamaged, (unsigned long long)c.bitFlips,
       (unsigned long long)c.droppedBytes, (unsigned long long)c.garbageBytes, (unsigned long long)c.requests,
       (unsigned long long)c.badRequests, (unsigned long long)c.naksInjected, (unsigned long long)c.ignoredBytes,
-      (unsigned long long)c.vanishes, (unsigned long long)c.powerOns);
+      (unsigned long long)c.undeliveredBytes, (unsigned long long)c.overrunBytes, (unsigned long long)c.vanishes, (unsigned long long)c.powerOns);
   return 0;
 }

@@ -19,6 +19,9 @@ namespace fusedet::drivers::lms291::sim {
 namespace {
 constexpr auto kRotation = std::chrono::nanoseconds(1'000'000'000 / 75);  // mirror at 75 Hz
 constexpr std::uint8_t kDeviceAddress = 0x80;
+// Rotations missed while the thread was descheduled are replayed up to this far back; a longer
+// gap is a stopped process, and its scans are counted (scansStalled) rather than burst out.
+constexpr auto kMaxCatchUp = std::chrono::seconds(1);
 
 std::vector<std::uint8_t> ascii(const std::string& s) { return {s.begin(), s.end()}; }
 
@@ -97,10 +100,6 @@ void Simulator::powerOn() {
   mode_ = static_cast<std::uint8_t>(Mode::kMonitoring);
   variant_ = options_.variant;
   out_.clear();
-  outPos_ = 0;
-  outDamaged_ = false;
-  outDropped_ = false;
-  lineBytes_.clear();
   reader_.clear();
   rotation_ = 0;
   telegramIndex_ = 0;
@@ -407,58 +406,68 @@ void Simulator::readHost(Clock::time_point now) {
   }
 }
 
+Simulator::Clock::duration Simulator::lineTime(std::size_t bytes) const {
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(byteSeconds(baud_) * 1e9 * static_cast<double>(bytes)));
+}
+
 void Simulator::pumpOutput(Clock::time_point now) {
+  // The line is modelled in time, not by this thread's wake-ups: each output unit (telegram,
+  // ACK/NAK, garbage burst) starts when it is due and the line is free, and is written to the
+  // pty in one piece once its last byte has left the (virtual) UART. A descheduled simulator
+  // thread therefore delays delivery, like a USB adapter's packet, but never splits a telegram
+  // with a pause the host must take for a dead frame (the LMS leaves <= 14 ms between bytes)
+  // and never loses line time it has to make up for by skipping scans.
   while (!out_.empty()) {
     Output& o = out_.front();
-    if (now < o.notBefore || now < lineFreeAt_) return;
-    // About a millisecond of line time per write keeps the pacing close to the real UART's.
-    const std::size_t chunk = std::min(o.bytes.size() - outPos_, std::max<std::size_t>(1, static_cast<std::size_t>(baud_ / 10000)));
+    const Clock::time_point start = std::max(lineFreeAt_, o.notBefore);
+    const Clock::time_point end = start + lineTime(o.bytes.size());
+    if (now < end) return;
     std::vector<std::uint8_t> bytes;
-    bytes.reserve(chunk);
-    for (std::size_t i = 0; i < chunk; ++i) {
-      std::uint8_t b = o.bytes[outPos_ + i];
+    bytes.reserve(o.bytes.size());
+    bool damaged = false, dropped = false;
+    for (std::uint8_t b : o.bytes) {
       if (faults_.dropRate > 0 && std::uniform_real_distribution<>(0, 1)(rng_) < faults_.dropRate) {
         ++counters_.droppedBytes;
-        outDamaged_ = true;
-        outDropped_ = true;
+        damaged = dropped = true;
         continue;
       }
       if (faults_.bitFlipRate > 0 && std::uniform_real_distribution<>(0, 1)(rng_) < faults_.bitFlipRate) {
         b ^= static_cast<std::uint8_t>(1u << std::uniform_int_distribution<int>(0, 7)(rng_));
         ++counters_.bitFlips;
-        outDamaged_ = true;
+        damaged = true;
       }
       bytes.push_back(b);
     }
-    if (o.telegram) lineBytes_.insert(lineBytes_.end(), bytes.begin(), bytes.end());
     if (!bytes.empty()) {
       const int host = hostBaud();
-      ssize_t n = 0;
-      if (host == baud_) n = ::write(master_.get(), bytes.data(), bytes.size());
-      const std::size_t lost = bytes.size() - static_cast<std::size_t>(std::max<ssize_t>(n, 0));
-      counters_.undeliveredBytes += lost;
+      std::size_t written = 0;
+      if (host == baud_) {
+        const ssize_t n = ::write(master_.get(), bytes.data(), bytes.size());
+        written = static_cast<std::size_t>(std::max<ssize_t>(n, 0));
+        // The host's receive buffer is full (it stopped reading): an overrun, counted apart
+        // from the bytes a speed mismatch swallows.
+        counters_.overrunBytes += bytes.size() - written;
+      } else {
+        counters_.undeliveredBytes += bytes.size();
+      }
       counters_.bytesOut += bytes.size();
-      if (options_.trace && (outPos_ == 0 || lost > 0))
-        std::fprintf(stderr, "%s sim: %s 0x%02X at %d baud, host at %d%s\n", Stamp::now().toString().c_str(),
-                     outPos_ == 0 ? "start" : "cont.", o.bytes.size() > 4 ? o.bytes[4] : o.bytes[0], baud_, host,
-                     lost ? " - NOT DELIVERED" : "");
+      if (options_.trace)
+        std::fprintf(stderr, "%s sim: sent 0x%02X (%zu bytes) at %d baud, host at %d%s\n", Stamp::now().toString().c_str(),
+                     o.bytes.size() > 4 ? o.bytes[4] : o.bytes[0], bytes.size(), baud_, host,
+                     host != baud_ ? " - NOT DELIVERED" : written < bytes.size() ? " - OVERRUN" : "");
     }
-    // A UART sends at a constant rate: if this thread woke late, catch up (within 2 ms).
-    lineFreeAt_ = std::max(lineFreeAt_, now - std::chrono::milliseconds(2)) +
-                  std::chrono::nanoseconds(static_cast<std::int64_t>(byteSeconds(baud_) * 1e9 * static_cast<double>(chunk)));
-    outPos_ += chunk;
-    if (outPos_ < o.bytes.size()) continue;
+    lineFreeAt_ = end;
     if (o.telegram) {
       ++counters_.telegramsOut;
       if (o.scan) ++counters_.scansOut;
-      if (outDamaged_) {
+      if (damaged) {
         ++counters_.telegramsDamaged;
         if (o.scan) {
           ++counters_.scansDamaged;
           if (damagedScans_.size() < 1'000'000) damagedScans_.push_back(o.scanNumber);
-          const std::size_t n = lineBytes_.size();
-          if (!outDropped_ && n >= kFrameOverhead &&
-              crc16(std::span(lineBytes_).first(n - 2)) == (lineBytes_[n - 2] | (lineBytes_[n - 1] << 8))) {
+          const std::size_t n = bytes.size();
+          if (!dropped && n >= kFrameOverhead &&
+              crc16(std::span(bytes).first(n - 2)) == (bytes[n - 2] | (bytes[n - 1] << 8))) {
             ++counters_.scansCrcBlind;
             crcBlindScans_.push_back(o.scanNumber);
           }
@@ -467,10 +476,6 @@ void Simulator::pumpOutput(Clock::time_point now) {
     }
     if (o.baudAfter) setDeviceBaud(o.baudAfter);
     out_.pop_front();
-    outPos_ = 0;
-    outDamaged_ = false;
-    outDropped_ = false;
-    lineBytes_.clear();
   }
 }
 
@@ -500,14 +505,26 @@ void Simulator::run() {
     const bool streaming = mode_ == 0x24 || mode_ == 0x2A || mode_ == 0x2B;
     if (streaming && now < silentUntil_) nextRotation_ = now + kRotation;  // a hung device measures nothing
     if (streaming && now >= nextRotation_) {
-      if (now - nextRotation_ > std::chrono::milliseconds(100)) nextRotation_ = now;  // we were descheduled
+      // Woke late: replay the rotations in time order (the device's mirror does not wait). Only
+      // beyond kMaxCatchUp (a stopped process, not scheduling jitter) are rotations given up,
+      // and their scans counted as stalled.
+      const auto rotations = static_cast<std::uint64_t>(variant_.rotations());
+      if (now - nextRotation_ > kMaxCatchUp) {
+        const auto behind = static_cast<std::uint64_t>((now - nextRotation_) / kRotation);
+        for (std::uint64_t i = 0; i < behind; ++i)
+          if (++rotation_ % rotations == 0 || mode_ == 0x2A) ++counters_.scansStalled;
+        nextRotation_ += behind * kRotation;
+      }
       while (nextRotation_ <= now) {
+        const Clock::time_point at = nextRotation_;
         ++rotation_;
         nextRotation_ += kRotation;
-        const bool scanReady = mode_ == 0x2A || rotation_ % static_cast<std::uint64_t>(variant_.rotations()) == 0;
+        const bool scanReady = mode_ == 0x2A || rotation_ % rotations == 0;
         if (!scanReady) continue;
+        if (now >= silentUntil_) pumpOutput(at);  // what had left the line by then
+        // Sent only if the line is idle at that rotation (a slow line drops scans).
         if (out_.empty())
-          queueScan(now);
+          queueScan(at);
         else
           ++counters_.scansSkipped;
       }
@@ -515,7 +532,8 @@ void Simulator::run() {
     if (now >= silentUntil_) pumpOutput(now);
     auto wake = now + std::chrono::milliseconds(5);
     if (streaming) wake = std::min(wake, nextRotation_);
-    if (!out_.empty()) wake = std::min(wake, std::max(lineFreeAt_, out_.front().notBefore));
+    if (!out_.empty())
+      wake = std::min(wake, std::max(lineFreeAt_, out_.front().notBefore) + lineTime(out_.front().bytes.size()));
     const int fd = master_.get();
     lock.unlock();
     const auto waitUs = std::chrono::duration_cast<std::chrono::microseconds>(wake - Clock::now()).count();

@@ -3,7 +3,9 @@
 // side (or the symlink `link`); the simulator plays the device on the master side.
 //
 // Line speed. A pty accepts any termios speed but does not pace bytes, so the simulator
-//  - paces its own output at the device's current baud (10 bits per byte, 8N1), and
+//  - paces its own output at the device's current baud (10 bits per byte, 8N1) on a virtual
+//    line: each telegram is written whole once its last byte has left it (a late thread
+//    replays the missed rotations and writes what is due, never splitting a telegram), and
 //  - reads the speed the host set on its side (TCGETS2 on the master returns the slave's
 //    termios). Bytes written by the host while its speed differs from the device's are
 //    discarded (a real LMS sees framing errors and ignores them), and device output while
@@ -68,6 +70,9 @@ struct SimCounters {
   std::uint64_t telegramsOut = 0;      // telegrams put on the line
   std::uint64_t scansOut = 0;          // measured-value telegrams (B0/F5) put on the line
   std::uint64_t scansSkipped = 0;      // scans not sent because the line was busy
+  // Scans of rotations given up because the simulator thread was stopped for over a second
+  // (shorter delays are replayed in time order, so scheduling jitter never skips a scan).
+  std::uint64_t scansStalled = 0;
   std::uint64_t telegramsDamaged = 0;  // telegrams with >= 1 flipped or dropped byte
   std::uint64_t scansDamaged = 0;      // of them measured-value telegrams
   // Damaged scans whose CRC still matches (bit flips only, no drops): no receiver can reject them.
@@ -80,6 +85,7 @@ struct SimCounters {
   std::uint64_t naksInjected = 0;
   std::uint64_t ignoredBytes = 0;      // host bytes at the wrong speed
   std::uint64_t undeliveredBytes = 0;  // device bytes while the host speed differed
+  std::uint64_t overrunBytes = 0;      // device bytes the host's full receive buffer refused
   std::uint64_t vanishes = 0;
   std::uint64_t powerOns = 0;
 };
@@ -143,6 +149,7 @@ class Simulator {
   std::vector<std::uint16_t> scanValues(int rotation, int rotations, std::vector<std::uint16_t>* remission);
   std::uint16_t encodeRange(double meters) const;
   void pumpOutput(Clock::time_point now);
+  Clock::duration lineTime(std::size_t bytes) const;
   int hostBaud() const;
   void setDeviceBaud(int baud);
 
@@ -167,12 +174,8 @@ class Simulator {
   std::uint64_t rotation_ = 0;
   std::uint8_t telegramIndex_ = 0;
   Clock::time_point nextRotation_;
-  Clock::time_point lineFreeAt_;
+  Clock::time_point lineFreeAt_;  // when the last output unit's last byte left the line
   std::deque<Output> out_;
-  std::size_t outPos_ = 0;       // bytes of out_.front() already sent
-  bool outDamaged_ = false;      // current telegram got a fault
-  bool outDropped_ = false;      // ... and lost a byte
-  std::vector<std::uint8_t> lineBytes_;  // current telegram as it went on the line
   Faults faults_;
   int nakStorm_ = 0;
   Clock::time_point silentUntil_;

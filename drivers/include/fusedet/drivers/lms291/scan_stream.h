@@ -1,7 +1,8 @@
 #pragma once
 // ScanStream: runs an Lms291 on its own thread and keeps it running. When the port vanishes
 // (USB adapter unplugged) or the device falls silent, it closes, waits (back-off doubling from
-// 50 ms up to reconnectMax) and re-initialises from scratch. stop() ends streaming, returns the
+// 50 ms up to reconnectMax; while the device node is absent, it is watched every 20 ms instead)
+// and re-initialises from scratch. stop() ends streaming, returns the
 // device to 9600 baud and joins the thread.
 
 #include <atomic>
@@ -52,6 +53,8 @@ class ScanStream {
  private:
   void run();
   bool sleepFor(std::chrono::milliseconds d);  // false if stop() was called
+  bool waitForDevice(const std::string& path);  // until the node exists; false if stopped
+  static constexpr std::chrono::milliseconds kDevicePoll{20};
 
   Lms291 device_;
   ScanHandler onScan_;
