@@ -17,6 +17,7 @@
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/lms291/scan_stream.h"
 #include "simulator.h"
+#include "default_room.h"
 
 using namespace fusedet::drivers::lms291;
 using fusedet::drivers::LaserScan;
@@ -25,20 +26,7 @@ using namespace std::chrono_literals;
 
 namespace {
 
-// The simulator's default room: side walls at x = +-3 m, front wall at y = 5 m, a post of
-// radius 0.2 m at (0.5, 2.0); the scanner at the origin looking along +y.
-double expectedRange(double deg) {
-  const double a = deg * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
-  double best = 1e9;
-  if (c > 1e-9) best = std::min(best, 3.0 / c);
-  if (c < -1e-9) best = std::min(best, -3.0 / c);
-  if (s > 1e-9) best = std::min(best, 5.0 / s);
-  // Post: distance along the ray to the circle |p - (0.5, 2)| = 0.2.
-  const double along = 0.5 * c + 2.0 * s;
-  const double off2 = 0.5 * 0.5 + 2.0 * 2.0 - along * along;
-  if (off2 <= 0.04 && along > 0) best = std::min(best, along - std::sqrt(0.04 - off2));
-  return best;
-}
+double expectedRange(double deg) { return fusedet::testing::expectedRoomRange(deg); }
 
 // Every beam (but the counter beam 0 when `counter`) matches the room to the millimetre.
 ::testing::AssertionResult matchesRoom(const LaserScan& s, bool counter) {

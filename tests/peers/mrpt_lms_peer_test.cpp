@@ -17,23 +17,13 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <string>
 
+#include "../drivers/default_room.h"
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Room of the simulator's default scene, computed here: walls x = +-3 m, y = 5 m, post r 0.2 m
-// at (0.5, 2).
-double expectedRange(double deg) {
-  const double a = deg * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
-  double best = 1e9;
-  if (c > 1e-9) best = std::min(best, 3.0 / c);
-  if (c < -1e-9) best = std::min(best, -3.0 / c);
-  if (s > 1e-9) best = std::min(best, 5.0 / s);
-  const double along = 0.5 * c + 2.0 * s;
-  const double off2 = 4.25 - along * along;
-  if (off2 <= 0.04 && along > 0) best = std::min(best, along - std::sqrt(0.04 - off2));
-  return best;
-}
+double expectedRange(double deg) { return fusedet::testing::expectedRoomRange(deg); }
 
 // lms291-sim as a child process; its stdout (device line, then JSON counters) through a pipe.
 struct SimProcess {
