@@ -2,6 +2,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "fusedet/drivers/usb/usb_match.h"
+#include "fusedet/drivers/v4l2/controls.h"
+
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -51,6 +54,8 @@ class Section {
     for (const T& a : allowed) msg << ' ' << a;
     fail(node_ ? node_[key] : node_, msg.str());
   }
+
+  YAML::Node at(const char* key) const { return node_ && node_.IsMap() ? node_[key] : YAML::Node(); }
 
   Section child(const char* key) {
     seen_.insert(key);
@@ -135,10 +140,21 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
   {
     Section s = top.child("camera");
     s.read("device", c.camera.device);
-    s.readOneOf<std::string>("format", c.camera.format, {"yuyv", "mjpeg"});
+    s.read("usb", c.camera.usb);
+    if (!c.camera.usb.empty())
+      if (auto m = drivers::usb::parseUsbMatch(c.camera.usb); !m) s.fail(s.at("usb"), "key camera.usb: " + m.error().context);
+    s.readOneOf<std::string>("format", c.camera.format, {"yuyv", "mjpeg", "auto"});
     s.readRange("width", c.camera.width, 16, 8192);
     s.readRange("height", c.camera.height, 16, 8192);
     s.readRange("fps", c.camera.fps, 1, 240);
+    s.readRange("buffers", c.camera.buffers, 4, 32);
+    for (const auto& [key, value] : {std::pair{"exposure", &c.camera.exposure}, std::pair{"gain", &c.camera.gain}}) {
+      s.read(key, *value);
+      if (!drivers::v4l2::parseControlSetting(*value))
+        s.fail(s.at(key), std::string("key camera.") + key + ": '" + *value + "' is neither auto nor a non-negative integer");
+    }
+    s.readRange("stall_ms", c.camera.stallMs, 100, 600000);
+    s.readRange("reconnect_max_s", c.camera.reconnectMaxS, 0.1, 600.0);
     s.read("calibration", c.camera.calibration);
     s.finish();
   }
@@ -219,10 +235,16 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "heartbeat_ms" << YAML::Value << c.tilt.heartbeatMs << YAML::EndMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "device" << YAML::Value << c.camera.device;
+  out << YAML::Key << "usb" << YAML::Value << c.camera.usb;
   out << YAML::Key << "format" << YAML::Value << c.camera.format;
   out << YAML::Key << "width" << YAML::Value << c.camera.width;
   out << YAML::Key << "height" << YAML::Value << c.camera.height;
   out << YAML::Key << "fps" << YAML::Value << c.camera.fps;
+  out << YAML::Key << "buffers" << YAML::Value << c.camera.buffers;
+  out << YAML::Key << "exposure" << YAML::Value << c.camera.exposure;
+  out << YAML::Key << "gain" << YAML::Value << c.camera.gain;
+  out << YAML::Key << "stall_ms" << YAML::Value << c.camera.stallMs;
+  out << YAML::Key << "reconnect_max_s" << YAML::Value << c.camera.reconnectMaxS;
   out << YAML::Key << "calibration" << YAML::Value << c.camera.calibration << YAML::EndMap;
   out << YAML::Key << "fusion" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "laser_to_camera" << YAML::Value << YAML::BeginMap;

@@ -6,16 +6,6 @@
 
 namespace fusedet::drivers::lms291 {
 
-std::string_view toString(StreamState s) {
-  switch (s) {
-    case StreamState::kStopped: return "stopped";
-    case StreamState::kConnecting: return "connecting";
-    case StreamState::kStreaming: return "streaming";
-    case StreamState::kBackingOff: return "backing off";
-  }
-  return "unknown";
-}
-
 ScanStream::ScanStream(Lms291Config config, ScanHandler onScan, std::chrono::milliseconds reconnectMax,
                        std::chrono::milliseconds silenceLimit)
     : device_(std::move(config)), onScan_(std::move(onScan)), reconnectMax_(reconnectMax), silenceLimit_(silenceLimit) {

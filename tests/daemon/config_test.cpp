@@ -46,6 +46,25 @@ TEST(Config, ErrorsNameFileLineAndKey) {
   EXPECT_NE(errorOf("tilt:\n  min_deg: 10\n  max_deg: 5\n").find("min_deg must be below"), std::string::npos);
 }
 
+TEST(Config, CameraKeys) {
+  const Config c = parseConfig("camera:\n  usb: 046d:0825:ABC\n  format: auto\n  exposure: 8000\n  gain: auto\n  buffers: 6\n",
+                               "cam.yaml");
+  EXPECT_EQ(c.camera.usb, "046d:0825:ABC");
+  EXPECT_EQ(c.camera.format, "auto");
+  EXPECT_EQ(c.camera.exposure, "8000");
+  EXPECT_EQ(c.camera.buffers, 6);
+  const Config back = parseConfig(dumpConfig(c), "dump.yaml");
+  EXPECT_EQ(back.camera.exposure, "8000");
+  EXPECT_EQ(back.camera.usb, "046d:0825:ABC");
+  EXPECT_EQ(errorOf("camera:\n  exposure: fast\n"),
+            "test.yaml:2: key camera.exposure: 'fast' is neither auto nor a non-negative integer");
+  EXPECT_EQ(errorOf("camera:\n  gain: -3\n"), "test.yaml:2: key camera.gain: '-3' is neither auto nor a non-negative integer");
+  EXPECT_EQ(errorOf("camera:\n  buffers: 2\n"), "test.yaml:2: key camera.buffers: 2 is outside [4, 32]");
+  EXPECT_NE(errorOf("camera:\n  usb: '0403'\n").find("test.yaml:2: key camera.usb: USB device '0403': no ':'"),
+            std::string::npos);
+  EXPECT_NE(errorOf("camera:\n  format: rgb\n").find("is not one of: yuyv mjpeg auto"), std::string::npos);
+}
+
 TEST(Config, MissingFile) {
   EXPECT_THROW((void)loadConfig("/nonexistent/fusedet.yaml"), ConfigError);
 }

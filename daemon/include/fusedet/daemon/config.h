@@ -46,8 +46,14 @@ struct Config {
 
   struct Camera {
     std::string device = "/dev/video0";
-    std::string format = "yuyv";
+    std::string usb;                 // VID:PID[:SERIAL]; non-empty: the video node of that USB camera
+    std::string format = "yuyv";     // yuyv | mjpeg | auto
     int width = 640, height = 480, fps = 15;
+    int buffers = 4;                 // mmap capture buffers
+    std::string exposure = "auto";   // auto | microseconds
+    std::string gain = "auto";       // auto | device units
+    int stallMs = 2000;              // no frame this long: restart the stream, then reopen
+    double reconnectMaxS = 5.0;
     std::string calibration = "/etc/fusedet/camera.yaml";
   } camera;
 

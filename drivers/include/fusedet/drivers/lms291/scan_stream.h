@@ -14,11 +14,11 @@
 #include <thread>
 
 #include "fusedet/drivers/lms291/lms291.h"
+#include "fusedet/drivers/stream_state.h"
 
 namespace fusedet::drivers::lms291 {
 
-enum class StreamState { kStopped, kConnecting, kStreaming, kBackingOff };
-std::string_view toString(StreamState s);
+using drivers::StreamState;  // shared with the camera stream (stream_state.h)
 
 struct ScanStreamCounters {
   Lms291Counters device;
