@@ -1,6 +1,8 @@
 #include "fusedet/boost/detector.h"
 
+#include "integral_grids.h"
 #include "opencv_pyramid.h"
+#include "window_scanner.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
@@ -49,23 +51,15 @@ struct ScalePlan {
 };
 
 std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, const ScanParams& p) {
-  if (!(p.scaleFactor > 1)) throw std::invalid_argument("scale factor must be > 1");
   const int W = in.width(), H = in.height();
-  const int maxW = p.maxWidth > 0 ? std::min(p.maxWidth, W) : W;
-  const int maxH = p.maxHeight > 0 ? std::min(p.maxHeight, H) : H;
-  double s0 = 1.0;
-  if (p.minWidth > 0 || p.minHeight > 0)
-    s0 = std::max(double(p.minWidth) / c.windowWidth, double(p.minHeight) / c.windowHeight);
   std::vector<ScalePlan> plans;
-  for (double s = s0;; s *= p.scaleFactor) {
+  for (ScaleWindows& win : windowScales(c, W, H, p)) {
     ScalePlan sp;
-    sp.winW = std::max(1, roundHalfUp(c.windowWidth * s));
-    sp.winH = std::max(1, roundHalfUp(c.windowHeight * s));
-    if (sp.winW > maxW || sp.winH > maxH) break;
-    if (sp.winW < p.minWidth || sp.winH < p.minHeight) continue;
-    sp.step = std::max(1, roundHalfUp(p.step * s));
-    for (int x = 0; x + sp.winW <= W; x += sp.step) sp.xs.push_back(x);
-    for (int y = 0; y + sp.winH <= H; y += sp.step) sp.ys.push_back(y);
+    sp.winW = win.winW;
+    sp.winH = win.winH;
+    sp.step = win.step;
+    sp.xs = std::move(win.xs);
+    sp.ys = std::move(win.ys);
     const std::size_t nl = in.size();
     sp.colOfs.resize(nl);
     sp.rowOfs.resize(nl);
@@ -184,7 +178,15 @@ Detector& Detector::operator=(Detector&&) noexcept = default;
 
 std::vector<RawHit> Detector::scan(const LayerStack& stack, const ScanParams& params, ScanStats* stats) const {
   if (cascade_.isOpenCv()) return scanOpenCvPyramid(cascade_, stack, params, stats);
-  return scan(integrateFor(cascade_, stack), params, stats);
+  const IntegralGrids grids(stack, layerRequests(cascade_), params.threads);
+  std::vector<ScanStats> st;
+  std::vector<std::vector<RawHit>> hits = scanCascades({&cascade_}, grids, params, stats ? &st : nullptr);
+  if (stats) {
+    stats->windows += st[0].windows;
+    stats->stumps += st[0].stumps;
+    stats->scales += st[0].scales;
+  }
+  return std::move(hits[0]);
 }
 
 std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& params, ScanStats* stats) const {

@@ -400,6 +400,7 @@ cv::Mat eightBit(const Layer& l) {
 }  // namespace
 
 void setVectorScanEnabled(bool enabled) { gVectorEnabled = enabled; }
+bool vectorScanEnabled() { return gVectorEnabled.load(std::memory_order_relaxed); }
 
 void integrateCv(const cv::Mat& gray, bool tilted, CvIntegrals& out) {
   const int w = gray.cols, h = gray.rows;

@@ -16,6 +16,9 @@
 
 namespace fusedet::boosting {
 
+// setVectorScanEnabled()'s process-wide switch; both scanners (this one and window_scanner.h) read it.
+bool vectorScanEnabled();
+
 std::vector<RawHit> scanOpenCvPyramid(const Cascade& cascade, const LayerStack& stack,
                                       const ScanParams& params, ScanStats* stats);
 

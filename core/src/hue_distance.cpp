@@ -10,19 +10,19 @@ double hueDistanceDeg(double hueDeg, double referenceDeg) {
   return d > 180.0 ? 360.0 - d : d;
 }
 
+void hueDistanceRow(const float* in, float* o, int n, double referenceDeg) {
+  const auto ref = static_cast<float>(std::fmod(std::fmod(referenceDeg, 360.0) + 360.0, 360.0));
+  for (int x = 0; x < n; ++x) {
+    // Both in [0, 360): |h - ref| < 360, so one fold is enough.
+    const float d = std::fabs(in[x] - ref);
+    o[x] = d > 180.f ? 360.f - d : d;
+  }
+}
+
 cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, double referenceDeg) {
   if (hueDeg.type() != CV_32FC1) throw std::invalid_argument("hueDistanceLayer: hue must be CV_32FC1 degrees");
   cv::Mat out(hueDeg.size(), CV_32FC1);
-  const auto ref = static_cast<float>(std::fmod(std::fmod(referenceDeg, 360.0) + 360.0, 360.0));
-  for (int y = 0; y < hueDeg.rows; ++y) {
-    const float* in = hueDeg.ptr<float>(y);
-    float* o = out.ptr<float>(y);
-    for (int x = 0; x < hueDeg.cols; ++x) {
-      // Both in [0, 360): |h - ref| < 360, so one fold is enough.
-      const float d = std::fabs(in[x] - ref);
-      o[x] = d > 180.f ? 360.f - d : d;
-    }
-  }
+  for (int y = 0; y < hueDeg.rows; ++y) hueDistanceRow(hueDeg.ptr<float>(y), out.ptr<float>(y), hueDeg.cols, referenceDeg);
   return out;
 }
 

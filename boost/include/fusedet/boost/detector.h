@@ -8,8 +8,12 @@
 // pyramid of their one 8-bit layer instead (opencv_cascade.h has the details), so that their
 // window decisions equal cv::CascadeClassifier's.
 //
-// Threads: rows of each scale are split over TBB tasks; hits are merged in (scale, row, column)
-// order, so the output is identical for any thread count.
+// Two scanners with the same decisions (tested): scan(LayerStack) builds its integrals in one pass
+// into grids whose layers' rows are interleaved and evaluates four windows per step with AVX2
+// (multi_detector.h runs several models this way on one pass); scan(IntegralStack) is the
+// one-window-at-a-time path on per-layer tables that training uses and tests compare against.
+// Threads: bands of window columns over TBB tasks; hits are merged in (scale, row, column) order,
+// so the output is identical for any thread count.
 
 #include <cstddef>
 #include <memory>
@@ -70,7 +74,7 @@ class Detector {
   // Raw hits of every window; stats (optional) counts the work done.
   std::vector<RawHit> scan(const LayerStack& stack, const ScanParams& params,
                            ScanStats* stats = nullptr) const;
-  // Same on integrals built by the caller (our models only).
+  // Same on integrals built by the caller (our models only; the scalar reference scanner).
   std::vector<RawHit> scan(const IntegralStack& integrals, const ScanParams& params,
                            ScanStats* stats = nullptr) const;
 

@@ -12,4 +12,7 @@ double hueDistanceDeg(double hueDeg, double referenceDeg);
 // hueDeg: CV_32FC1 hue in degrees [0, 360). Returns CV_32FC1 of the same size, values in [0, 180].
 cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, double referenceDeg);
 
+// One row of hueDistanceLayer (the same values): n hues in degrees [0, 360) -> out.
+void hueDistanceRow(const float* hueDeg, float* out, int n, double referenceDeg);
+
 }  // namespace fusedet

@@ -1,0 +1,141 @@
+#include "integral_grids.h"
+
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "fusedet/core/hue_distance.h"
+
+namespace fusedet::boosting {
+
+namespace {
+
+// One source layer feeding one slot: its pixels, or hue to be turned into hue_distance per row.
+struct Source {
+  cv::Mat data;
+  std::optional<double> hueReference;  // set: data is hue (CV_32F), the slot is hue_distance
+};
+
+// Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum.
+template <class T>
+void integrateSlot(const cv::Mat& data, double* slot0, std::ptrdiff_t pitch) {
+  const int w = data.cols, h = data.rows;
+  for (int y = 0; y < h; ++y) {
+    const T* row = data.ptr<T>(y);
+    const double* prev = slot0 + y * pitch;
+    double* cur = slot0 + (y + 1) * pitch;
+    double rowSum = 0;
+    for (int x = 0; x < w; ++x) {
+      rowSum += static_cast<double>(row[x]);
+      cur[x + 1] = prev[x + 1] + rowSum;
+    }
+  }
+}
+
+void integrateHueDistance(const cv::Mat& hue, double reference, double* slot0, std::ptrdiff_t pitch) {
+  const int w = hue.cols, h = hue.rows;
+  std::vector<float> dist(static_cast<std::size_t>(w));
+  for (int y = 0; y < h; ++y) {
+    hueDistanceRow(hue.ptr<float>(y), dist.data(), w, reference);
+    const double* prev = slot0 + y * pitch;
+    double* cur = slot0 + (y + 1) * pitch;
+    double rowSum = 0;
+    for (int x = 0; x < w; ++x) {
+      rowSum += static_cast<double>(dist[static_cast<std::size_t>(x)]);
+      cur[x + 1] = prev[x + 1] + rowSum;
+    }
+  }
+}
+
+void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
+  if (s.hueReference) return integrateHueDistance(s.data, *s.hueReference, slot0, pitch);
+  switch (s.data.depth()) {
+    case CV_8U: return integrateSlot<std::uint8_t>(s.data, slot0, pitch);
+    case CV_16U: return integrateSlot<std::uint16_t>(s.data, slot0, pitch);
+    case CV_32F: return integrateSlot<float>(s.data, slot0, pitch);
+    case CV_64F: return integrateSlot<double>(s.data, slot0, pitch);
+    default: throw std::invalid_argument("IntegralGrids: layer depth must be 8U, 16U, 32F or 64F");
+  }
+}
+
+}  // namespace
+
+IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerRequest>& requests, int threads)
+    : refWidth_(stack.width()), refHeight_(stack.height()) {
+  if (refWidth_ <= 0 || refHeight_ <= 0) throw std::invalid_argument("IntegralGrids: stack has no reference size");
+  // Resolve every distinct request to its source (IntegralStack's rules) and group by pixel grid.
+  struct Job {
+    Source source;
+    SlotRef ref;
+  };
+  std::vector<Job> jobs;
+  stackHasHueDistance_ = stack.has(layer::kHueDistance);
+  for (const LayerRequest& asked : requests) {
+    const LayerRequest r = normalized(asked);
+    if (std::any_of(index_.begin(), index_.end(), [&](const auto& e) { return e.first == r; })) continue;
+    Source src;
+    const Layer* l = stack.find(r.name);
+    if (!l && r.name == layer::kHueDistance && stack.has(layer::kHue)) {
+      if (!r.referenceHue) throw std::invalid_argument("IntegralGrids: layer 'hue_distance' needs a reference hue");
+      src.data = stack.at(layer::kHue).data;
+      if (src.data.type() != CV_32FC1) src.data.convertTo(src.data, CV_32F);
+      src.hueReference = r.referenceHue;
+    } else {
+      if (!l) stack.at(r.name);  // throws, naming the missing layer and the ones present
+      if (l->data.channels() != 1 || l->data.empty())
+        throw std::invalid_argument("IntegralGrids: layer '" + r.name + "' must be a non-empty single-channel image");
+      src.data = l->data;
+    }
+    const int w = src.data.cols, h = src.data.rows;
+    auto g = std::find_if(grids_.begin(), grids_.end(), [&](const IntegralGrid& x) { return x.width == w && x.height == h; });
+    if (g == grids_.end()) {
+      grids_.push_back(IntegralGrid{});
+      g = grids_.end() - 1;
+      g->width = w;
+      g->height = h;
+      g->stride = w + 1;
+    }
+    const SlotRef ref{static_cast<int>(g - grids_.begin()), static_cast<int>(g->slots.size())};
+    g->slots.push_back(r);
+    index_.emplace_back(r, ref);
+    jobs.push_back(Job{src, ref});
+  }
+  for (IntegralGrid& g : grids_) {
+    g.pitch = g.stride * static_cast<std::ptrdiff_t>(g.slots.size());
+    // Row 0 of every slot stays zero; each slot writes only its own part of the rows after it.
+    g.data.assign(static_cast<std::size_t>(g.pitch) * static_cast<std::size_t>(g.height + 1) + kGridPad, 0.0);
+  }
+  auto run = [&](std::size_t i) {
+    const Job& j = jobs[i];
+    IntegralGrid& g = grids_[static_cast<std::size_t>(j.ref.grid)];
+    integrateSource(j.source, g.data.data() + j.ref.slot * g.stride, g.pitch);
+  };
+  if (threads == 1 || jobs.size() < 2) {
+    for (std::size_t i = 0; i < jobs.size(); ++i) run(i);
+    return;
+  }
+  auto all = [&] { tbb::parallel_for(std::size_t(0), jobs.size(), run); };
+  if (threads > 1) {
+    tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
+    arena.execute(all);
+  } else {
+    all();
+  }
+}
+
+LayerRequest IntegralGrids::normalized(const LayerRequest& r) const {
+  if (r.name == layer::kHueDistance && !stackHasHueDistance_) return r;
+  return LayerRequest{r.name, std::nullopt};
+}
+
+SlotRef IntegralGrids::find(const LayerRequest& request) const {
+  const LayerRequest key = normalized(request);
+  for (const auto& [r, ref] : index_)
+    if (r == key) return ref;
+  throw std::logic_error("IntegralGrids: layer '" + request.name + "' was not requested");
+}
+
+}  // namespace fusedet::boosting

@@ -1,0 +1,361 @@
+#include "window_scanner.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <tuple>
+
+#include "opencv_pyramid.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define FUSEDET_HAVE_AVX2_GRID_PATH 1
+#endif
+
+namespace fusedet::boosting {
+
+namespace {
+
+int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
+
+// One stump laid out for one scale: its rectangles' corners as offsets from the window's origin in
+// its grid, (x0,y0) (x1,y0) (x0,y1) (x1,y1). black = rect 0 (+ rect 1 for the checker); white =
+// rect 2, minus black when rect 2 is the outer rectangle (FeatureLayout's rule).
+struct GridStump {
+  int grid = 0;
+  bool checker = false;
+  bool whiteIsRest = false;
+  std::array<std::array<std::int32_t, 4>, 3> ofs{};
+  double blackArea = 1, whiteArea = 1;
+  float threshold = 0;
+  double left = 0, right = 0;
+};
+
+struct GridStage {
+  std::uint32_t begin = 0, end = 0;
+  double threshold = 0;
+};
+
+struct GridScale {
+  ScaleWindows win;
+  std::vector<std::vector<std::int32_t>> colOfs, rowOfs;  // per grid, per position
+  std::vector<GridStump> stumps;
+  std::vector<GridStage> stages;
+};
+
+GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector<SlotRef>& slots, ScaleWindows win) {
+  GridScale sp;
+  const int W = in.refWidth(), H = in.refHeight();
+  const std::size_t ng = in.grids().size();
+  sp.colOfs.resize(ng);
+  sp.rowOfs.resize(ng);
+  std::vector<std::array<int, 2>> lwSize(ng);
+  for (std::size_t g = 0; g < ng; ++g) {
+    const IntegralGrid& gr = in.grids()[g];
+    LayerIntegral geometry;  // the mapping rule needs only the layer's size (and name for errors)
+    geometry.name = gr.slots.front().name;
+    geometry.width = gr.width;
+    geometry.height = gr.height;
+    lwSize[g] = layerWindowSize(geometry, W, H, win.winW, win.winH);
+    const double sx = double(gr.width) / W, sy = double(gr.height) / H;
+    for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
+    for (int y : win.ys)
+      sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
+  }
+  for (const Stage& st : c.stages) {
+    GridStage gs{static_cast<std::uint32_t>(sp.stumps.size()), 0, st.threshold};
+    for (const Stump& t : st.stumps) {
+      const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+      const SlotRef ref = slots[static_cast<std::size_t>(f.layer)];
+      const IntegralGrid& gr = in.grids()[static_cast<std::size_t>(ref.grid)];
+      const auto& lw = lwSize[static_cast<std::size_t>(ref.grid)];
+      const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lw[0], lw[1]));
+      const std::ptrdiff_t slot0 = ref.slot * gr.stride;
+      auto corners = [&](const PixelRect& r) {
+        return std::array<std::int32_t, 4>{static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x0),
+                                           static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x1),
+                                           static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x0),
+                                           static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x1)};
+      };
+      GridStump z;
+      z.grid = ref.grid;
+      z.checker = lay.blackCount == 2;
+      z.whiteIsRest = lay.whiteIsRest;
+      z.ofs[0] = corners(lay.rects[0]);
+      if (z.checker) z.ofs[1] = corners(lay.rects[1]);
+      z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
+      z.blackArea = lay.blackArea;
+      z.whiteArea = lay.whiteArea;
+      z.threshold = static_cast<float>(t.threshold);
+      z.left = t.left;
+      z.right = t.right;
+      sp.stumps.push_back(z);
+    }
+    gs.end = static_cast<std::uint32_t>(sp.stumps.size());
+    sp.stages.push_back(gs);
+  }
+  sp.win = std::move(win);
+  return sp;
+}
+
+// Windows of one chunk in structure-of-arrays form, compacted in place after each stage. Offsets:
+// the window's origin in each grid. Four entries of padding behind the last window hold a valid
+// window so that vector lanes past the end read inside the grids.
+struct WindowList {
+  std::size_t cap = 0, grids = 0;
+  std::vector<std::int32_t> off;  // grids x cap
+  std::vector<std::int32_t> xi, yi;
+  std::vector<double> score;
+  void reserve(std::size_t windows, std::size_t nGrids) {
+    cap = windows + 4;
+    grids = nGrids;
+    off.assign(cap * grids, 0);
+    xi.assign(cap, 0);
+    yi.assign(cap, 0);
+    score.assign(cap, 0);
+  }
+  std::int32_t* offsets(std::size_t g) { return off.data() + g * cap; }
+  void pad(std::size_t n) {
+    for (std::size_t g = 0; g < grids; ++g)
+      for (std::size_t k = n; k < n + 4; ++k) offsets(g)[k] = n ? offsets(g)[0] : 0;
+  }
+  void keep(std::size_t from, std::size_t to, double s) {
+    for (std::size_t g = 0; g < grids; ++g) offsets(g)[to] = offsets(g)[from];
+    xi[to] = xi[from];
+    yi[to] = yi[from];
+    score[to] = s;
+  }
+};
+
+// The value of one stump on one window, as featureValue() computes it (see GridStump).
+inline float stumpValue(const GridStump& z, const double* p) {
+  auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
+  double black = rs(z.ofs[0]);
+  if (z.checker) black = black + rs(z.ofs[1]);
+  double white = rs(z.ofs[2]);
+  if (z.whiteIsRest) white = white - black;
+  return static_cast<float>(black / z.blackArea - white / z.whiteArea);
+}
+
+// One stage on windows [0, n) of the list, one window at a time; keeps those that pass.
+std::size_t stageScalar(const GridScale& sp, const GridStage& st, const double* const* grids, WindowList& l,
+                        std::size_t n) {
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (std::uint32_t k = st.begin; k < st.end; ++k) {
+      const GridStump& z = sp.stumps[k];
+      const float v = stumpValue(z, grids[z.grid] + l.offsets(static_cast<std::size_t>(z.grid))[i]);
+      sum += v < z.threshold ? z.left : z.right;
+    }
+    if (!(sum < st.threshold)) l.keep(i, kept++, sum);
+  }
+  l.pad(kept);
+  return kept;
+}
+
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+// Rectangle sums of four windows (origins b + o[k]), in stumpValue()'s order.
+__attribute__((target("avx2"))) inline __m256d rectSum4(const double* b, __m128i o, const std::array<std::int32_t, 4>& c) {
+  // The masked form with every lane on: GCC 12 warns about the plain form's undefined source.
+  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), zero = _mm256_setzero_pd();
+  const __m256d p0 = _mm256_mask_i32gather_pd(zero, b + c[0], o, all, 8);
+  const __m256d p1 = _mm256_mask_i32gather_pd(zero, b + c[1], o, all, 8);
+  const __m256d p2 = _mm256_mask_i32gather_pd(zero, b + c[2], o, all, 8);
+  const __m256d p3 = _mm256_mask_i32gather_pd(zero, b + c[3], o, all, 8);
+  return _mm256_add_pd(_mm256_sub_pd(_mm256_sub_pd(p3, p1), p2), p0);
+}
+
+// The same, four windows per step: every operation of stumpValue() and the stage sum per lane in
+// the same order (separate multiply-free add/sub/div, no FMA), so lanes equal the scalar path.
+__attribute__((target("avx2"))) std::size_t stageAvx2(const GridScale& sp, const GridStage& st,
+                                                      const double* const* grids, WindowList& l, std::size_t n) {
+  constexpr std::size_t kMaxGrids = 8;
+  const std::size_t ng = l.grids;
+  std::size_t kept = 0;
+  const __m256d stageThreshold = _mm256_set1_pd(st.threshold);
+  alignas(32) double sums[4];
+  for (std::size_t i = 0; i < n; i += 4) {
+    __m128i off[kMaxGrids];
+    for (std::size_t g = 0; g < ng; ++g) off[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(l.offsets(g) + i));
+    __m256d sum = _mm256_setzero_pd();
+    for (std::uint32_t k = st.begin; k < st.end; ++k) {
+      const GridStump& z = sp.stumps[k];
+      const double* b = grids[z.grid];
+      const __m128i o = off[z.grid];
+      __m256d black = rectSum4(b, o, z.ofs[0]);
+      if (z.checker) black = _mm256_add_pd(black, rectSum4(b, o, z.ofs[1]));
+      __m256d white = rectSum4(b, o, z.ofs[2]);
+      if (z.whiteIsRest) white = _mm256_sub_pd(white, black);
+      const __m256d d = _mm256_sub_pd(_mm256_div_pd(black, _mm256_set1_pd(z.blackArea)),
+                                      _mm256_div_pd(white, _mm256_set1_pd(z.whiteArea)));
+      const __m256d v = _mm256_cvtps_pd(_mm256_cvtpd_ps(d));  // rounded to float, as featureValue()
+      const __m256d lt = _mm256_cmp_pd(v, _mm256_set1_pd(double(z.threshold)), _CMP_LT_OQ);
+      sum = _mm256_add_pd(sum, _mm256_blendv_pd(_mm256_set1_pd(z.right), _mm256_set1_pd(z.left), lt));
+    }
+    int pass = _mm256_movemask_pd(_mm256_cmp_pd(sum, stageThreshold, _CMP_NLT_UQ));  // !(sum < threshold)
+    if (n - i < 4) pass &= (1 << (n - i)) - 1;
+    if (!pass) continue;
+    _mm256_store_pd(sums, sum);
+    for (int k = 0; k < 4; ++k)
+      if ((pass >> k) & 1) l.keep(i + std::size_t(k), kept++, sums[k]);
+  }
+  l.pad(kept);
+  return kept;
+}
+
+bool cpuHasAvx2Gather() {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+}
+#endif
+
+std::size_t runStage(const GridScale& sp, const GridStage& st, const double* const* grids, WindowList& l,
+                     std::size_t n) {
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+  if (l.grids <= 8 && vectorScanEnabled() && cpuHasAvx2Gather()) return stageAvx2(sp, st, grids, l, n);
+#endif
+  return stageScalar(sp, st, grids, l, n);
+}
+
+constexpr std::size_t kBand = 48;          // window columns per work item
+constexpr std::size_t kChunkWindows = 512;  // windows per breadth-first chunk (rows of a band)
+
+// Every row of columns [x0, x1) of one scale: hits appended in (row, column) order.
+void scanBand(const GridScale& sp, const double* const* grids, std::size_t ng, std::size_t x0, std::size_t x1,
+              int scaleIndex, WindowList& l, std::vector<RawHit>& hits, std::size_t& stumps) {
+  const std::size_t bw = x1 - x0, rows = sp.win.ys.size();
+  const std::size_t rowsPerChunk = std::max<std::size_t>(1, kChunkWindows / bw);
+  if (l.cap < rowsPerChunk * bw + 4 || l.grids != ng) l.reserve(rowsPerChunk * bw, ng);
+  for (std::size_t y0 = 0; y0 < rows; y0 += rowsPerChunk) {
+    const std::size_t y1 = std::min(rows, y0 + rowsPerChunk);
+    std::size_t n = 0;
+    for (std::size_t yi = y0; yi < y1; ++yi)
+      for (std::size_t xi = x0; xi < x1; ++xi, ++n) {
+        for (std::size_t g = 0; g < ng; ++g) l.offsets(g)[n] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
+        l.xi[n] = static_cast<std::int32_t>(xi);
+        l.yi[n] = static_cast<std::int32_t>(yi);
+      }
+    l.pad(n);
+    for (const GridStage& st : sp.stages) {
+      stumps += n * (st.end - st.begin);
+      n = runStage(sp, st, grids, l, n);
+      if (n == 0) break;
+    }
+    for (std::size_t k = 0; k < n; ++k)
+      hits.push_back(RawHit{Box{double(sp.win.xs[static_cast<std::size_t>(l.xi[k])]),
+                                double(sp.win.ys[static_cast<std::size_t>(l.yi[k])]), double(sp.win.winW),
+                                double(sp.win.winH)},
+                            l.score[k], scaleIndex});
+  }
+}
+
+}  // namespace
+
+std::vector<ScaleWindows> windowScales(const Cascade& c, int W, int H, const ScanParams& p) {
+  if (!(p.scaleFactor > 1)) throw std::invalid_argument("scale factor must be > 1");
+  const int maxW = p.maxWidth > 0 ? std::min(p.maxWidth, W) : W;
+  const int maxH = p.maxHeight > 0 ? std::min(p.maxHeight, H) : H;
+  double s0 = 1.0;
+  if (p.minWidth > 0 || p.minHeight > 0)
+    s0 = std::max(double(p.minWidth) / c.windowWidth, double(p.minHeight) / c.windowHeight);
+  std::vector<ScaleWindows> out;
+  for (double s = s0;; s *= p.scaleFactor) {
+    ScaleWindows sw;
+    sw.winW = std::max(1, roundHalfUp(c.windowWidth * s));
+    sw.winH = std::max(1, roundHalfUp(c.windowHeight * s));
+    if (sw.winW > maxW || sw.winH > maxH) break;
+    if (sw.winW < p.minWidth || sw.winH < p.minHeight) continue;
+    sw.step = std::max(1, roundHalfUp(p.step * s));
+    for (int x = 0; x + sw.winW <= W; x += sw.step) sw.xs.push_back(x);
+    for (int y = 0; y + sw.winH <= H; y += sw.step) sw.ys.push_back(y);
+    out.push_back(std::move(sw));
+  }
+  return out;
+}
+
+std::vector<LayerRequest> layerRequests(const Cascade& c) {
+  std::vector<LayerRequest> out;
+  for (const std::string& name : c.layers)
+    out.push_back(LayerRequest{name, name == layer::kHueDistance ? c.referenceHue : std::nullopt});
+  return out;
+}
+
+std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>& cascades, const IntegralGrids& in,
+                                              const ScanParams& params, std::vector<ScanStats>* stats) {
+  const std::size_t nc = cascades.size(), ng = in.grids().size();
+  for (const IntegralGrid& g : in.grids())
+    if (static_cast<double>(g.pitch) * (g.height + 1) >= 2147483647.0)
+      throw std::invalid_argument("scan: layers too large for 32-bit offsets (" + std::to_string(g.width) + "x" +
+                                  std::to_string(g.height) + " x " + std::to_string(g.slots.size()) + " layers)");
+  std::vector<std::vector<GridScale>> plans(nc);
+  for (std::size_t c = 0; c < nc; ++c) {
+    const Cascade& cc = *cascades[c];
+    if (cc.isOpenCv()) throw std::invalid_argument("scanCascades: OpenCV models scan their own pyramid");
+    std::vector<SlotRef> slots;
+    for (const LayerRequest& r : layerRequests(cc)) slots.push_back(in.find(r));
+    for (ScaleWindows& w : windowScales(cc, in.refWidth(), in.refHeight(), params))
+      plans[c].push_back(planScale(cc, in, slots, std::move(w)));
+  }
+  // Work items: a band of window columns of one scale of one cascade, all its rows; one index
+  // space for everything so that threads share the work across cascades and scales.
+  struct Item {
+    std::size_t cascade, scale, x0, x1;
+  };
+  std::vector<Item> items;
+  for (std::size_t c = 0; c < nc; ++c)
+    for (std::size_t s = 0; s < plans[c].size(); ++s)
+      for (std::size_t x0 = 0; x0 < plans[c][s].win.xs.size(); x0 += kBand)
+        items.push_back(Item{c, s, x0, std::min(plans[c][s].win.xs.size(), x0 + kBand)});
+  std::vector<const double*> grids(ng);
+  for (std::size_t g = 0; g < ng; ++g) grids[g] = in.grids()[g].data.data();
+  std::vector<std::vector<RawHit>> hits(items.size());
+  std::vector<std::size_t> stumpCount(items.size(), 0);
+  auto runItem = [&](std::size_t i, WindowList& l) {
+    const Item& it = items[i];
+    scanBand(plans[it.cascade][it.scale], grids.data(), ng, it.x0, it.x1, static_cast<int>(it.scale), l, hits[i],
+             stumpCount[i]);
+  };
+  if (params.threads == 1) {
+    WindowList l;
+    for (std::size_t i = 0; i < items.size(); ++i) runItem(i, l);
+  } else {
+    auto run = [&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+        WindowList l;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) runItem(i, l);
+      });
+    };
+    if (params.threads > 1) {
+      tbb::task_arena arena(std::min(params.threads, tbb::info::default_concurrency()));
+      arena.execute(run);
+    } else {
+      run();
+    }
+  }
+  std::vector<std::vector<RawHit>> out(nc);
+  for (std::size_t i = 0; i < items.size(); ++i)
+    out[items[i].cascade].insert(out[items[i].cascade].end(), hits[i].begin(), hits[i].end());
+  for (auto& o : out)
+    std::sort(o.begin(), o.end(), [](const RawHit& a, const RawHit& b) {
+      return std::tie(a.scale, a.box.y, a.box.x) < std::tie(b.scale, b.box.y, b.box.x);
+    });
+  if (stats) {
+    stats->assign(nc, ScanStats{});
+    for (std::size_t c = 0; c < nc; ++c) {
+      (*stats)[c].scales = plans[c].size();
+      for (const GridScale& sp : plans[c]) (*stats)[c].windows += sp.win.xs.size() * sp.win.ys.size();
+    }
+    for (std::size_t i = 0; i < items.size(); ++i) (*stats)[items[i].cascade].stumps += stumpCount[i];
+  }
+  return out;
+}
+
+}  // namespace fusedet::boosting
