@@ -179,8 +179,6 @@ int runGrab(const CameraOptions& o) {
   const CameraCounters counters = camera.counters();
   camera.stop();
 
-  bool increasing = true;
-  for (std::size_t i = 1; i < frames.size(); ++i) increasing = increasing && frames[i].stamp > frames[i - 1].stamp;
   json list = json::array();
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const drivers::CameraFrame& f = frames[i];
@@ -217,13 +215,13 @@ int runGrab(const CameraOptions& o) {
       {"buffers", info->buffers},
       {"notes", info->notes},
       {"restarts", restarts},
-      {"stamps_increasing", increasing},
+      {"stamps_increasing", counters.stampsBackwards == 0},
       {"raw_buffers", raws.size()},
       {"counters",
        {{"frames", counters.frames}, {"bytes", counters.bytes}, {"lost_frames", counters.lostFrames},
         {"sequence_gaps", counters.sequenceGaps}, {"sequence_resets", counters.sequenceResets},
         {"error_frames", counters.errorFrames}, {"short_frames", counters.shortFrames},
-        {"host_stamps", counters.hostStamps}, {"timeouts", counters.timeouts},
+        {"host_stamps", counters.hostStamps}, {"stamps_backwards", counters.stampsBackwards}, {"timeouts", counters.timeouts},
         {"buffer_errors", counters.bufferErrors}, {"stream_starts", counters.streamStarts}}},
       {"frames", list}};
   if (o.json) {
@@ -272,7 +270,7 @@ const bool registered = registerCommand(
       grab->add_option("--gain", o->gain, "auto, or a fixed gain in device units")->capture_default_str();
       grab->add_flag("--raw", o->raw, "also write each raw buffer as seen by the recording hook (buffer_NNNN.yuyv|.mjpg)");
       grab->add_flag("--json", o->json, "print one JSON summary (format, interval, counters, frames[sequence, stamp, bytes, file])");
-      app.footer(
+      const std::string footer =
           std::string("Frames are captured first and written afterwards, so writing never makes the driver drop frames.\n"
                       "grab reports lost frames (gaps in the driver's sequence numbers), error and short buffers, frames\n"
                       "stamped on the host because the driver's stamps are not CLOCK_MONOTONIC, and whether the stamps\n"
@@ -282,7 +280,8 @@ const bool registered = registerCommand(
                       "  fusedet camera grab --device /dev/video0 --count 5 --out /tmp/frames\n"
                       "  fusedet camera grab --device /dev/video0 --count 100 --restart-every 50 --json | jq .counters\n"
                       "  fusedet camera grab --device /dev/video0 --format mjpeg --exposure 10000 --gain 0 --out /tmp/f\n") +
-          kDeviceExitHelp);
+          kDeviceExitHelp;
+      for (CLI::App* a : {&app, list, grab}) a->footer(footer);
       return [o, list, grab]() -> int {
         if (list->parsed()) return runList(*o);
         if (grab->parsed()) return runGrab(*o);

@@ -145,7 +145,7 @@ const bool registered = registerCommand(
       watch->add_option("--duration", o->duration, "stop after S seconds (0 = no limit)")->capture_default_str();
       watch->add_option("--count", o->count, "stop after N events (0 = no limit)")->capture_default_str();
       watch->add_flag("--json", o->json, "one JSON object per event: the list fields plus event (arrived|left)");
-      app.footer(std::string(
+      const std::string footer = std::string(
                      "Strings (serial, manufacturer, product) and /dev nodes (ttyUSB*, ttyACM*, video*) come from sysfs,\n"
                      "so listing needs no permission on the device; reset needs write access to /dev/bus/usb (root).\n"
                      "A node may be missing for a moment after an arrival, until the interface driver binds.\n"
@@ -154,7 +154,8 @@ const bool registered = registerCommand(
                      "  fusedet usb list 0403:6001 --json | jq -r '.[0].nodes[0]'\n"
                      "  fusedet usb reset 0403:6001:A50285BI\n"
                      "  fusedet usb watch 046d:0825 --json\n") +
-                 kDeviceExitHelp);
+                 kDeviceExitHelp;
+      for (CLI::App* a : {&app, list, reset, watch}) a->footer(footer);
       return [o, list, reset, watch]() -> int {
         if (list->parsed()) return runList(*o);
         if (reset->parsed()) return runReset(*o);

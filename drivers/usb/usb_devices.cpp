@@ -65,6 +65,14 @@ Result<std::vector<UsbDeviceInfo>> UsbBus::list(const std::optional<UsbMatch>& m
   return out;
 }
 
+Result<std::string> UsbBus::resolveNode(const UsbMatch& match, const std::string& prefix) {
+  auto all = list(match);
+  if (!all) return all.error();
+  auto one = selectOne(*all, match);
+  if (!one) return one.error();
+  return nodeOf(*one, prefix);
+}
+
 Result<UsbDeviceInfo> UsbBus::reset(const UsbMatch& match) {
   auto all = list(match);
   if (!all) return all.error();

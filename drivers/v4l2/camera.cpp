@@ -426,6 +426,8 @@ Result<CameraFrame> V4l2Camera::readFrame(std::chrono::milliseconds timeout) {
     const std::uint64_t sequence = nextSequence_++;
     if (!deliver) continue;
     frame.sequence = sequence;
+    if (lastStamp_ && frame.stamp <= *lastStamp_) ++counters_.stampsBackwards;
+    lastStamp_ = frame.stamp;
     ++counters_.frames;
     counters_.bytes += frame.bytes.size();
     return frame;

@@ -97,7 +97,18 @@ TEST(V4l2Camera, FramesCarryDriverStampBytesAndContinuousSequence) {
   EXPECT_EQ(c.sequenceGaps, 1u);
   EXPECT_EQ(c.lostFrames, 2u);
   EXPECT_EQ(c.hostStamps, 0u);
+  EXPECT_EQ(c.stampsBackwards, 0u);
   EXPECT_EQ(rig.fake->queued.size(), 4u);  // every buffer went straight back
+}
+
+TEST(V4l2Camera, StampsThatDoNotIncreaseAreCounted) {
+  Rig rig;
+  auto& cam = rig.make();
+  ASSERT_TRUE(cam.start());
+  rig.fake->script = {FakeFrame{0, 0, -1, 3'000'000'000}, FakeFrame{1, 0, -1, 2'000'000'000},
+                      FakeFrame{2, 0, -1, 2'000'000'000}, FakeFrame{3, 0, -1, 2'000'001'000}};  // V4L2 stamps have microseconds
+  for (int i = 0; i < 4; ++i) ASSERT_TRUE(cam.readFrame(100ms));
+  EXPECT_EQ(cam.counters().stampsBackwards, 2u);
 }
 
 TEST(V4l2Camera, NonMonotonicStampsAreReplacedAndCounted) {

@@ -42,6 +42,9 @@ class UsbBus {
 
   // All devices (no match) or those matching, in bus/port order.
   Result<std::vector<UsbDeviceInfo>> list(const std::optional<UsbMatch>& match = std::nullopt);
+  // The node (name starting with `prefix`: "video", "ttyUSB", "tty") of the one device matching
+  // `match`: what the daemon opens when the configuration names a USB camera or adapter by id.
+  Result<std::string> resolveNode(const UsbMatch& match, const std::string& prefix);
   // Resets the one matching device; returns it as it was found before the reset.
   Result<UsbDeviceInfo> reset(const UsbMatch& match);
 

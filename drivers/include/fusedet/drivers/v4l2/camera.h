@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -71,6 +72,7 @@ struct CameraCounters {
   std::uint64_t errorFrames = 0;     // buffers flagged V4L2_BUF_FLAG_ERROR (not delivered)
   std::uint64_t shortFrames = 0;     // empty, or less than one image of raw pixels (not delivered)
   std::uint64_t hostStamps = 0;      // frames stamped at dequeue: the driver's stamp is not monotonic
+  std::uint64_t stampsBackwards = 0; // frames not stamped after the frame before them
   std::uint64_t timeouts = 0;        // poll timeouts
   std::uint64_t bufferErrors = 0;    // dequeue answers inconsistent with the bookkeeping
   std::uint64_t streamStarts = 0;    // VIDIOC_STREAMON done (first start and restarts)
@@ -135,6 +137,7 @@ class V4l2Camera {
   std::vector<Mapping> mappings_;
   SequenceTracker sequence_;
   CameraCounters counters_;
+  std::optional<Stamp> lastStamp_;   // of the last frame returned
   std::uint64_t nextSequence_ = 0;  // CameraFrame::sequence: continues across restarts, skips lost frames
   bool streaming_ = false;
   RawHook rawHook_;
