@@ -56,6 +56,7 @@ std::optional<PixelFormat> pixelFormatOf(std::uint32_t fourcc) {
 }
 
 bool SizeRange::contains(std::uint32_t w, std::uint32_t h) const {
+  if (!valid()) return false;
   if (w < minWidth || w > maxWidth || h < minHeight || h > maxHeight) return false;
   if (stepWidth != 0 && (w - minWidth) % stepWidth != 0) return false;
   if (stepHeight != 0 && (h - minHeight) % stepHeight != 0) return false;
@@ -63,6 +64,7 @@ bool SizeRange::contains(std::uint32_t w, std::uint32_t h) const {
 }
 
 std::pair<std::uint32_t, std::uint32_t> SizeRange::nearest(std::uint32_t w, std::uint32_t h) const {
+  if (!valid()) return {minWidth, minHeight};
   return {clampStep(w, minWidth, maxWidth, stepWidth), clampStep(h, minHeight, maxHeight, stepHeight)};
 }
 
@@ -124,11 +126,13 @@ Result<NegotiatedFormat> negotiateFormat(const std::string& device, std::span<co
   n.pixelFormat = *pixelFormatOf(chosen->fourcc);
   n.width = request.width;
   n.height = request.height;
-  if (chosen->sizes.empty()) return n;  // nothing enumerated: S_FMT tells what the device makes of it
+  const bool anyValid = std::any_of(chosen->sizes.begin(), chosen->sizes.end(), [](const SizeRange& r) { return r.valid(); });
+  if (!anyValid) return n;  // nothing (usable) enumerated: S_FMT tells what the device makes of it
   for (const SizeRange& r : chosen->sizes)
     if (r.contains(request.width, request.height)) return n;
   std::uint64_t best = UINT64_MAX;
   for (const SizeRange& r : chosen->sizes) {
+    if (!r.valid()) continue;
     const auto [w, h] = r.nearest(request.width, request.height);
     const std::uint64_t d = sizeDistance(w, h, request.width, request.height);
     // Ties go to the larger image: downscaling later loses less than upscaling.
@@ -147,8 +151,9 @@ std::optional<Fraction> chooseInterval(std::span<const IntervalRange> offers, do
   double bestDistance = 0;
   const double target = fps > 0 ? 1.0 / fps : 0.0;
   for (const IntervalRange& r : offers) {
+    if (!r.valid()) continue;
     Fraction f = r.min;
-    if (!r.isDiscrete() && r.min.valid() && r.max.valid()) {
+    if (!r.isDiscrete()) {
       const double t = std::clamp(target, r.min.value(), r.max.value());
       if (r.step.valid()) {
         // min + k * step as one exact fraction, reduced.
@@ -162,7 +167,10 @@ std::optional<Fraction> chooseInterval(std::span<const IntervalRange> offers, do
         else
           f = r.max;
       } else {
-        f = Fraction{1000, static_cast<std::uint32_t>(std::max(1.0, std::round(1000.0 / t)))};
+        f = Fraction{1000, static_cast<std::uint32_t>(std::clamp(std::round(1000.0 / t), 1.0, 4e9))};
+        // Rounding to 1000/n may step just outside the range: its ends are exact then.
+        if (f.value() < r.min.value()) f = r.min;
+        if (f.value() > r.max.value()) f = r.max;
       }
     }
     if (!f.valid()) continue;

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <random>
 #include <thread>
 
 #include "fake_v4l2_device.h"
@@ -156,6 +157,54 @@ TEST(V4l2Camera, DequeueAnswersAgainstTheBookkeeping) {
   EXPECT_EQ(f.error().code, std::errc::protocol_error);
   EXPECT_EQ(f.error().context, "camera /dev/fake-video: the driver returned buffer 9 of 4");
   EXPECT_EQ(cam.counters().bufferErrors, 1u);
+}
+
+// A driver answering DQBUF with random sequence numbers, flags, sizes and bad indices: every buffer
+// ends up counted exactly once (frame, error, short or bookkeeping error), nothing crashes, and a
+// stream restart recovers from every refused answer.
+TEST(V4l2Camera, FuzzedDequeueAnswers) {
+  Rig rig;
+  rig.fake->formats = {{V4L2_PIX_FMT_YUYV, "YUYV 4:2:2", {{64, 48}}, {{1, 15}}}};  // small: 3000 buffers stay quick
+  CameraConfig config;
+  config.width = 64;
+  config.height = 48;
+  auto& cam = rig.make(config);
+  ASSERT_TRUE(cam.start());
+  std::mt19937 rng(5);
+  const std::size_t image = 64 * 48 * 2;
+  constexpr int kBuffers = 3000;
+  for (int i = 0; i < kBuffers; ++i) {
+    FakeFrame f;
+    f.sequence = rng() % 4 == 0 ? static_cast<std::uint32_t>(rng()) : static_cast<std::uint32_t>(i);
+    f.extraFlags = rng() % 10 == 0 ? V4L2_BUF_FLAG_ERROR : 0;
+    f.bytesUsed = rng() % 5 == 0 ? static_cast<std::int64_t>(rng() % (image + 100)) : -1;
+    // Out of range (4 buffers): a wrong index in range is indistinguishable from a right one.
+    f.forceIndex = rng() % 20 == 0 ? static_cast<std::int64_t>(4 + rng() % 100) : -1;
+    f.stampNs = 1'000'000'000 + static_cast<std::int64_t>(rng() % 1'000'000'000);
+    rig.fake->script.push_back(f);
+  }
+  std::uint64_t delivered = 0, refused = 0;
+  while (!rig.fake->script.empty()) {
+    auto f = cam.readFrame(50ms);
+    if (f) {
+      ++delivered;
+      ASSERT_EQ(f->bytes.size(), image);
+      continue;
+    }
+    if (f.error().code == std::errc::timed_out) {  // the last buffers were skipped ones
+      ASSERT_TRUE(rig.fake->script.empty());
+      break;
+    }
+    ++refused;
+    ASSERT_TRUE(cam.restartStream()) << f.error().message();
+  }
+  const CameraCounters c = cam.counters();
+  EXPECT_EQ(c.frames, delivered);
+  EXPECT_EQ(c.bufferErrors, refused);
+  EXPECT_EQ(c.frames + c.errorFrames + c.shortFrames + c.bufferErrors, static_cast<std::uint64_t>(kBuffers));
+  EXPECT_GT(c.frames, 1000u);
+  EXPECT_GT(c.bufferErrors, 10u);
+  EXPECT_GT(c.lostFrames, 0u);
 }
 
 TEST(V4l2Camera, PollTimeoutIsTimedOut) {

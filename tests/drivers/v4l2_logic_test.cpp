@@ -142,12 +142,78 @@ TEST(V4l2Interval, StepwiseAndContinuous) {
   EXPECT_NEAR(chooseInterval(std::vector{continuous}, 1)->value(), 0.5, 1e-9);
 }
 
+// Whatever a (broken) driver enumerates: no crash, and what is chosen is something offered.
+TEST(V4l2Negotiation, FuzzedOffersYieldOfferedChoicesOrClearErrors) {
+  std::mt19937 rng(21);  // 32-bit results
+  auto below = [&](std::uint32_t n) { return static_cast<std::uint32_t>(rng() % n); };
+  const std::uint32_t codes[] = {kYuyv, kMjpg, kRgb3, kJpeg, 0};
+  auto small = [&] { return static_cast<std::uint32_t>(rng() % 5 == 0 ? rng() : rng() % 4000); };
+  for (int i = 0; i < 20000; ++i) {
+    std::vector<FormatOffer> offers(rng() % 4);
+    for (FormatOffer& f : offers) {
+      f.fourcc = codes[rng() % 5];
+      f.sizes.resize(rng() % 4);
+      for (SizeRange& r : f.sizes)
+        r = rng() % 2 ? SizeRange::discrete(small(), small())
+                      : SizeRange{small(), small(), below(9), small(), small(), below(9)};
+    }
+    const CaptureRequest want{static_cast<FormatChoice>(rng() % 3), small(), small()};
+    const auto n = negotiateFormat("/dev/videoF", offers, want);
+    if (!n) {
+      EXPECT_EQ(n.error().context.rfind("camera /dev/videoF: wants ", 0), 0u);
+      continue;
+    }
+    const auto f = std::find_if(offers.begin(), offers.end(), [&](const FormatOffer& o) { return o.fourcc == n->fourcc; });
+    ASSERT_NE(f, offers.end());
+    const bool anyValid = std::any_of(f->sizes.begin(), f->sizes.end(), [](const SizeRange& r) { return r.valid(); });
+    if (!anyValid) {
+      EXPECT_EQ(n->width, want.width);  // nothing usable enumerated: the request goes to S_FMT
+      continue;
+    }
+    // The size lies inside an offered range (between its bounds; on its step grid when exact).
+    const bool inside = std::any_of(f->sizes.begin(), f->sizes.end(), [&](const SizeRange& r) {
+      return r.valid() && n->width >= r.minWidth && n->width <= r.maxWidth && n->height >= r.minHeight && n->height <= r.maxHeight;
+    });
+    EXPECT_TRUE(inside) << n->width << "x" << n->height;
+    EXPECT_EQ(n->sizeExact, n->width == want.width && n->height == want.height);
+  }
+  for (int i = 0; i < 20000; ++i) {
+    std::vector<IntervalRange> offers(rng() % 4);
+    for (IntervalRange& r : offers) {
+      const Fraction a{small(), small()}, b{small(), small()}, c{below(3), small()};
+      r = rng() % 2 ? IntervalRange::discrete(a) : IntervalRange{a, b, c};
+    }
+    const double fps = 0.5 + rng() % 500;
+    const auto f = chooseInterval(offers, fps);
+    const bool anyValid = std::any_of(offers.begin(), offers.end(), [](const IntervalRange& r) { return r.valid(); });
+    ASSERT_EQ(f.has_value(), anyValid);
+    if (!f) continue;
+    EXPECT_TRUE(f->valid());
+    const bool inside = std::any_of(offers.begin(), offers.end(), [&](const IntervalRange& r) {
+      return r.valid() && f->value() >= r.min.value() * (1 - 1e-9) && f->value() <= (r.isDiscrete() ? r.min : r.max).value() * (1 + 1e-9);
+    });
+    EXPECT_TRUE(inside) << f->numerator << "/" << f->denominator;
+  }
+}
+
 TEST(V4l2Format, ParseChoice) {
   EXPECT_EQ(parseFormatChoice("yuyv"), FormatChoice::kYuyv);
   EXPECT_EQ(parseFormatChoice("mjpeg"), FormatChoice::kMjpeg);
   EXPECT_EQ(parseFormatChoice("auto"), FormatChoice::kAuto);
   EXPECT_FALSE(parseFormatChoice("YUYV"));
   EXPECT_FALSE(parseFormatChoice(""));
+}
+
+TEST(V4l2Controls, ParseSetting) {
+  EXPECT_TRUE(parseControlSetting("auto")->automatic);
+  const auto fixed = parseControlSetting("10000");
+  ASSERT_TRUE(fixed);
+  EXPECT_FALSE(fixed->automatic);
+  EXPECT_EQ(fixed->value, 10000);
+  EXPECT_EQ(parseControlSetting("0")->value, 0);
+  EXPECT_EQ(parseControlSetting("2147483647")->value, 2147483647);
+  for (const char* bad : {"", "-1", "+5", "1e3", "10 ", "Auto", "2147483648", "99999999999", "0x10"})
+    EXPECT_FALSE(parseControlSetting(bad)) << bad;
 }
 
 TEST(V4l2Buffers, GrantedCountChecked) {

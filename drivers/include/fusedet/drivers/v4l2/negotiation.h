@@ -44,6 +44,8 @@ struct SizeRange {
   std::uint32_t minHeight = 0, maxHeight = 0, stepHeight = 0;
   static SizeRange discrete(std::uint32_t w, std::uint32_t h) { return {w, w, 0, h, h, 0}; }
   bool isDiscrete() const { return minWidth == maxWidth && minHeight == maxHeight; }
+  // A broken driver may report min > max or a zero size: such entries are never chosen.
+  bool valid() const { return minWidth > 0 && minHeight > 0 && minWidth <= maxWidth && minHeight <= maxHeight; }
   bool contains(std::uint32_t w, std::uint32_t h) const;
   // The size in this range closest to w x h (clamped, then rounded to the step).
   std::pair<std::uint32_t, std::uint32_t> nearest(std::uint32_t w, std::uint32_t h) const;
@@ -55,6 +57,7 @@ struct IntervalRange {
   Fraction min, max, step;
   static IntervalRange discrete(Fraction f) { return {f, f, {}}; }
   bool isDiscrete() const { return min == max; }
+  bool valid() const { return min.valid() && (isDiscrete() || (max.valid() && min.value() <= max.value())); }
 };
 
 struct FormatOffer {
