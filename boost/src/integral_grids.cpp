@@ -20,16 +20,16 @@ struct Source {
 };
 
 // Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum.
-template <class T>
-void integrateSlot(const cv::Mat& data, double* slot0, std::ptrdiff_t pitch) {
+template <class T, class Acc>
+void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
   const int w = data.cols, h = data.rows;
   for (int y = 0; y < h; ++y) {
     const T* row = data.ptr<T>(y);
-    const double* prev = slot0 + y * pitch;
-    double* cur = slot0 + (y + 1) * pitch;
-    double rowSum = 0;
+    const Acc* prev = slot0 + y * pitch;
+    Acc* cur = slot0 + (y + 1) * pitch;
+    Acc rowSum = 0;
     for (int x = 0; x < w; ++x) {
-      rowSum += static_cast<double>(row[x]);
+      rowSum += static_cast<Acc>(row[x]);
       cur[x + 1] = prev[x + 1] + rowSum;
     }
   }
@@ -50,6 +50,11 @@ void integrateHueDistance(const cv::Mat& hue, double reference, double* slot0, s
   }
 }
 
+// int32 tables are exact for 8-bit layers up to this many pixels (255 * pixels < 2^31).
+bool fitsInt32(const cv::Mat& data) {
+  return data.depth() == CV_8U && double(data.cols) * double(data.rows) * 255.0 < 2147483647.0;
+}
+
 void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
   if (s.hueReference) return integrateHueDistance(s.data, *s.hueReference, slot0, pitch);
   switch (s.data.depth()) {
@@ -61,7 +66,39 @@ void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
   }
 }
 
+// Tables of a camera-size stack take tens of MB and are needed again for the next stack: fresh
+// memory would cost page faults and zeroing every time, so each thread keeps the buffers of its
+// last grids (a few, released at thread exit).
+thread_local std::vector<std::vector<double>> tBuffers;
+thread_local std::vector<std::vector<std::int32_t>> tIntBuffers;
+
+template <class T>
+std::vector<T> takeBuffer(std::vector<std::vector<T>>& pool, std::size_t n) {
+  std::vector<T> b;
+  if (!pool.empty()) {
+    b = std::move(pool.back());
+    pool.pop_back();
+  }
+  b.resize(n);
+  return b;
+}
+
+// Zeroes what the integration does not write: row 0, column 0 of every slot's rows, the padding.
+template <class T>
+void prepare(std::vector<T>& d, const IntegralGrid& g, std::size_t n) {
+  std::fill(d.begin(), d.begin() + g.pitch, T(0));
+  for (std::size_t i = static_cast<std::size_t>(g.pitch); i < n; i += static_cast<std::size_t>(g.stride)) d[i] = T(0);
+  std::fill(d.begin() + static_cast<std::ptrdiff_t>(n), d.end(), T(0));
+}
+
 }  // namespace
+
+IntegralGrids::~IntegralGrids() {
+  for (IntegralGrid& g : grids_) {
+    if (tBuffers.size() < 4 && !g.data.empty()) tBuffers.push_back(std::move(g.data));
+    if (tIntBuffers.size() < 4 && !g.idata.empty()) tIntBuffers.push_back(std::move(g.idata));
+  }
+}
 
 IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerRequest>& requests, int threads)
     : refWidth_(stack.width()), refHeight_(stack.height()) {
@@ -90,12 +127,15 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
       src.data = l->data;
     }
     const int w = src.data.cols, h = src.data.rows;
-    auto g = std::find_if(grids_.begin(), grids_.end(), [&](const IntegralGrid& x) { return x.width == w && x.height == h; });
+    const bool exactInt = !src.hueReference && fitsInt32(src.data);
+    auto g = std::find_if(grids_.begin(), grids_.end(),
+                          [&](const IntegralGrid& x) { return x.width == w && x.height == h && x.exactInt == exactInt; });
     if (g == grids_.end()) {
       grids_.push_back(IntegralGrid{});
       g = grids_.end() - 1;
       g->width = w;
       g->height = h;
+      g->exactInt = exactInt;
       g->stride = w + 1;
     }
     const SlotRef ref{static_cast<int>(g - grids_.begin()), static_cast<int>(g->slots.size())};
@@ -105,13 +145,22 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
   }
   for (IntegralGrid& g : grids_) {
     g.pitch = g.stride * static_cast<std::ptrdiff_t>(g.slots.size());
-    // Row 0 of every slot stays zero; each slot writes only its own part of the rows after it.
-    g.data.assign(static_cast<std::size_t>(g.pitch) * static_cast<std::size_t>(g.height + 1) + kGridPad, 0.0);
+    const std::size_t n = static_cast<std::size_t>(g.pitch) * static_cast<std::size_t>(g.height + 1);
+    if (g.exactInt) {
+      g.idata = takeBuffer(tIntBuffers, n + kGridPad);
+      prepare(g.idata, g, n);
+    } else {
+      g.data = takeBuffer(tBuffers, n + kGridPad);
+      prepare(g.data, g, n);
+    }
   }
   auto run = [&](std::size_t i) {
     const Job& j = jobs[i];
     IntegralGrid& g = grids_[static_cast<std::size_t>(j.ref.grid)];
-    integrateSource(j.source, g.data.data() + j.ref.slot * g.stride, g.pitch);
+    if (g.exactInt)
+      integrateSlot<std::uint8_t>(j.source.data, g.idata.data() + j.ref.slot * g.stride, g.pitch);
+    else
+      integrateSource(j.source, g.data.data() + j.ref.slot * g.stride, g.pitch);
   };
   if (threads == 1 || jobs.size() < 2) {
     for (std::size_t i = 0; i < jobs.size(); ++i) run(i);

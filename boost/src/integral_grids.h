@@ -9,10 +9,12 @@
 // (y * pitch + s * stride + x), so a window needs one origin per grid, not one per layer.
 //
 // Values are those of integrateLayer() (integral_stack.h), bit for bit: double sums in the same
-// order. `hue_distance` is derived per reference hue (each class may have its own); a stack that
+// order. 8-bit layers whose whole sum stays below 2^31 get int32 tables instead (exact integers
+// either way, so every rectangle sum converts to the same double), half the memory to stream. `hue_distance` is derived per reference hue (each class may have its own); a stack that
 // carries its own hue_distance layer is used as is, as IntegralStack does.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,10 +32,13 @@ struct LayerRequest {
 
 struct IntegralGrid {
   int width = 0, height = 0;       // the layers' own pixel grid
+  bool exactInt = false;           // int32 tables in `idata` (8-bit layers), else double in `data`
   std::ptrdiff_t stride = 0;       // width + 1: one layer's integral row
   std::ptrdiff_t pitch = 0;        // slots * stride: one integral row of every slot
   std::vector<LayerRequest> slots;
   std::vector<double> data;        // (height + 1) * pitch values, then padding for vector reads
+  std::vector<std::int32_t> idata;  // the same layout when exactInt
+  const void* base() const { return exactInt ? static_cast<const void*>(idata.data()) : data.data(); }
 };
 
 // Where one requested layer lives.
@@ -47,6 +52,9 @@ class IntegralGrids {
   // cores). Throws std::out_of_range naming a missing layer (and the ones present),
   // std::invalid_argument for hue_distance without a reference hue or a stack without a size.
   IntegralGrids(const LayerStack& stack, const std::vector<LayerRequest>& requests, int threads);
+  ~IntegralGrids();  // hands the tables' buffers to the thread's next IntegralGrids
+  IntegralGrids(const IntegralGrids&) = delete;
+  IntegralGrids& operator=(const IntegralGrids&) = delete;
 
   int refWidth() const { return refWidth_; }
   int refHeight() const { return refHeight_; }

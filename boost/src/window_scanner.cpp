@@ -30,6 +30,7 @@ int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
 // rect 2, minus black when rect 2 is the outer rectangle (FeatureLayout's rule).
 struct GridStump {
   int grid = 0;
+  bool intGrid = false;  // the grid's tables are int32 (IntegralGrid::exactInt)
   bool checker = false;
   bool whiteIsRest = false;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
@@ -46,6 +47,9 @@ struct GridStage {
 struct GridScale {
   ScaleWindows win;
   std::vector<std::vector<std::int32_t>> colOfs, rowOfs;  // per grid, per position
+  // Per grid: 1 or 2 when neighbouring windows' origins are that many values apart along the whole
+  // row (plain or every-other vector loads replace gathers in stage 0), else 0.
+  std::vector<int> colStride;
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
 };
@@ -66,6 +70,14 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     lwSize[g] = layerWindowSize(geometry, W, H, win.winW, win.winH);
     const double sx = double(gr.width) / W, sy = double(gr.height) / H;
     for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
+    const auto& co = sp.colOfs[g];
+    sp.colStride.push_back(0);
+    for (int d : {1, 2}) {
+      bool regular = true;
+      for (std::size_t i = 1; i < co.size() && regular; ++i) regular = co[i] - co[i - 1] == d;
+      if (regular && co.size() > 1) sp.colStride.back() = d;
+    }
+    sp.colOfs[g].insert(sp.colOfs[g].end(), 4, sp.colOfs[g].back());  // padding for four-lane loads
     for (int y : win.ys)
       sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
   }
@@ -86,6 +98,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       };
       GridStump z;
       z.grid = ref.grid;
+      z.intGrid = gr.exactInt;
       z.checker = lay.blackCount == 2;
       z.whiteIsRest = lay.whiteIsRest;
       z.ofs[0] = corners(lay.rects[0]);
@@ -134,25 +147,36 @@ struct WindowList {
   }
 };
 
+// Rectangle sum at p (a window's origin in its grid): double tables in featureValue()'s order;
+// int32 tables (8-bit layers) exactly, so the double it converts to is the same.
+inline double rectSum(const double* p, const std::array<std::int32_t, 4>& o) {
+  return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]];
+}
+inline double rectSum(const std::int32_t* p, const std::array<std::int32_t, 4>& o) {
+  return static_cast<double>(std::int64_t(p[o[3]]) - p[o[1]] - p[o[2]] + p[o[0]]);
+}
+
 // The value of one stump on one window, as featureValue() computes it (see GridStump).
-inline float stumpValue(const GridStump& z, const double* p) {
-  auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
-  double black = rs(z.ofs[0]);
-  if (z.checker) black = black + rs(z.ofs[1]);
-  double white = rs(z.ofs[2]);
+template <class T>
+inline float stumpValue(const GridStump& z, const T* p) {
+  double black = rectSum(p, z.ofs[0]);
+  if (z.checker) black = black + rectSum(p, z.ofs[1]);
+  double white = rectSum(p, z.ofs[2]);
   if (z.whiteIsRest) white = white - black;
   return static_cast<float>(black / z.blackArea - white / z.whiteArea);
 }
 
 // One stage on windows [0, n) of the list, one window at a time; keeps those that pass.
-std::size_t stageScalar(const GridScale& sp, const GridStage& st, const double* const* grids, WindowList& l,
+std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* const* grids, WindowList& l,
                         std::size_t n) {
   std::size_t kept = 0;
   for (std::size_t i = 0; i < n; ++i) {
     double sum = 0;
     for (std::uint32_t k = st.begin; k < st.end; ++k) {
       const GridStump& z = sp.stumps[k];
-      const float v = stumpValue(z, grids[z.grid] + l.offsets(static_cast<std::size_t>(z.grid))[i]);
+      const std::int32_t o = l.offsets(static_cast<std::size_t>(z.grid))[i];
+      const float v = z.intGrid ? stumpValue(z, static_cast<const std::int32_t*>(grids[z.grid]) + o)
+                                : stumpValue(z, static_cast<const double*>(grids[z.grid]) + o);
       sum += v < z.threshold ? z.left : z.right;
     }
     if (!(sum < st.threshold)) l.keep(i, kept++, sum);
@@ -162,45 +186,94 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const double* 
 }
 
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-// Rectangle sums of four windows (origins b + o[k]), in stumpValue()'s order.
-__attribute__((target("avx2"))) inline __m256d rectSum4(const double* b, __m128i o, const std::array<std::int32_t, 4>& c) {
+constexpr std::size_t kMaxVectorGrids = 8;
+
+// Corner values of four windows, gathered (origins b + o[k]) or, for neighbours whose origins are
+// `stride` (1 or 2) apart, loaded from the first one's origin p. The same values either way.
+__attribute__((target("avx2"))) inline __m256d corners4(const double* b, __m128i o, int stride) {
+  if (stride == 1) return _mm256_loadu_pd(b);
+  if (stride == 2) {
+    const __m256d lo = _mm256_loadu_pd(b), hi = _mm256_loadu_pd(b + 4);  // p0..p3, p4..p7
+    return _mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), 0xD8);        // p0 p4 p2 p6 -> p0 p2 p4 p6
+  }
   // The masked form with every lane on: GCC 12 warns about the plain form's undefined source.
-  const __m256d all = _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), zero = _mm256_setzero_pd();
-  const __m256d p0 = _mm256_mask_i32gather_pd(zero, b + c[0], o, all, 8);
-  const __m256d p1 = _mm256_mask_i32gather_pd(zero, b + c[1], o, all, 8);
-  const __m256d p2 = _mm256_mask_i32gather_pd(zero, b + c[2], o, all, 8);
-  const __m256d p3 = _mm256_mask_i32gather_pd(zero, b + c[3], o, all, 8);
-  return _mm256_add_pd(_mm256_sub_pd(_mm256_sub_pd(p3, p1), p2), p0);
+  return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), b, o, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8);
+}
+__attribute__((target("avx2"))) inline __m128i corners4(const std::int32_t* b, __m128i o, int stride) {
+  if (stride == 1) return _mm_loadu_si128(reinterpret_cast<const __m128i*>(b));
+  if (stride == 2) {
+    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
+    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+  }
+  return _mm_mask_i32gather_epi32(_mm_setzero_si128(), b, o, _mm_set1_epi32(-1), 4);
 }
 
-// The same, four windows per step: every operation of stumpValue() and the stage sum per lane in
-// the same order (separate multiply-free add/sub/div, no FMA), so lanes equal the scalar path.
+// Rectangle sums of four windows, in rectSum()'s order (exact int32 arithmetic for int tables:
+// the integrals are monotone and below 2^31, so no step overflows).
+__attribute__((target("avx2"))) inline __m256d rectSum4(const double* b, __m128i o, int stride,
+                                                        const std::array<std::int32_t, 4>& c) {
+  const __m256d p0 = corners4(b + c[0], o, stride), p1 = corners4(b + c[1], o, stride);
+  const __m256d p2 = corners4(b + c[2], o, stride), p3 = corners4(b + c[3], o, stride);
+  return _mm256_add_pd(_mm256_sub_pd(_mm256_sub_pd(p3, p1), p2), p0);
+}
+__attribute__((target("avx2"))) inline __m256d rectSum4(const std::int32_t* b, __m128i o, int stride,
+                                                        const std::array<std::int32_t, 4>& c) {
+  const __m128i p0 = corners4(b + c[0], o, stride), p1 = corners4(b + c[1], o, stride);
+  const __m128i p2 = corners4(b + c[2], o, stride), p3 = corners4(b + c[3], o, stride);
+  return _mm256_cvtepi32_pd(_mm_add_epi32(_mm_sub_epi32(_mm_sub_epi32(p3, p1), p2), p0));
+}
+
+template <class T>
+__attribute__((target("avx2"))) inline void blackWhite4(const GridStump& z, const T* b, __m128i o, int stride,
+                                                        __m256d& black, __m256d& white) {
+  black = rectSum4(b, o, stride, z.ofs[0]);
+  if (z.checker) black = _mm256_add_pd(black, rectSum4(b, o, stride, z.ofs[1]));
+  white = rectSum4(b, o, stride, z.ofs[2]);
+}
+
+// Stage sums of four windows: every operation of stumpValue() and of the stage sum per lane, in
+// the same order (add/sub/div, no FMA), so lanes equal the scalar path. off[g]: the windows'
+// origins in grid g; first (row mode, may be null): the first window's origin per grid, for grids
+// whose neighbouring origins are regular (GridScale::colStride).
+__attribute__((target("avx2"))) inline __m256d stageSum4(const GridScale& sp, const GridStage& st,
+                                                         const void* const* grids, const __m128i* off,
+                                                         const std::int32_t* first) {
+  __m256d sum = _mm256_setzero_pd();
+  for (std::uint32_t k = st.begin; k < st.end; ++k) {
+    const GridStump& z = sp.stumps[k];
+    const auto g = static_cast<std::size_t>(z.grid);
+    const int stride = first ? sp.colStride[g] : 0;
+    const std::ptrdiff_t at = stride ? first[g] : 0;  // gathers add the lanes' own origins
+    __m256d black, white;
+    if (z.intGrid)
+      blackWhite4(z, static_cast<const std::int32_t*>(grids[g]) + at, off[g], stride, black, white);
+    else
+      blackWhite4(z, static_cast<const double*>(grids[g]) + at, off[g], stride, black, white);
+    if (z.whiteIsRest) white = _mm256_sub_pd(white, black);
+    const __m256d d = _mm256_sub_pd(_mm256_div_pd(black, _mm256_set1_pd(z.blackArea)),
+                                    _mm256_div_pd(white, _mm256_set1_pd(z.whiteArea)));
+    const __m256d v = _mm256_cvtps_pd(_mm256_cvtpd_ps(d));  // rounded to float, as featureValue()
+    const __m256d lt = _mm256_cmp_pd(v, _mm256_set1_pd(double(z.threshold)), _CMP_LT_OQ);
+    sum = _mm256_add_pd(sum, _mm256_blendv_pd(_mm256_set1_pd(z.right), _mm256_set1_pd(z.left), lt));
+  }
+  return sum;
+}
+
+__attribute__((target("avx2"))) inline int passMask(__m256d sum, double threshold) {
+  return _mm256_movemask_pd(_mm256_cmp_pd(sum, _mm256_set1_pd(threshold), _CMP_NLT_UQ));  // !(sum < threshold)
+}
+
+// A later stage on windows [0, n) of the list, four per step; keeps those that pass.
 __attribute__((target("avx2"))) std::size_t stageAvx2(const GridScale& sp, const GridStage& st,
-                                                      const double* const* grids, WindowList& l, std::size_t n) {
-  constexpr std::size_t kMaxGrids = 8;
+                                                      const void* const* grids, WindowList& l, std::size_t n) {
   const std::size_t ng = l.grids;
   std::size_t kept = 0;
-  const __m256d stageThreshold = _mm256_set1_pd(st.threshold);
   alignas(32) double sums[4];
   for (std::size_t i = 0; i < n; i += 4) {
-    __m128i off[kMaxGrids];
+    __m128i off[kMaxVectorGrids];
     for (std::size_t g = 0; g < ng; ++g) off[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(l.offsets(g) + i));
-    __m256d sum = _mm256_setzero_pd();
-    for (std::uint32_t k = st.begin; k < st.end; ++k) {
-      const GridStump& z = sp.stumps[k];
-      const double* b = grids[z.grid];
-      const __m128i o = off[z.grid];
-      __m256d black = rectSum4(b, o, z.ofs[0]);
-      if (z.checker) black = _mm256_add_pd(black, rectSum4(b, o, z.ofs[1]));
-      __m256d white = rectSum4(b, o, z.ofs[2]);
-      if (z.whiteIsRest) white = _mm256_sub_pd(white, black);
-      const __m256d d = _mm256_sub_pd(_mm256_div_pd(black, _mm256_set1_pd(z.blackArea)),
-                                      _mm256_div_pd(white, _mm256_set1_pd(z.whiteArea)));
-      const __m256d v = _mm256_cvtps_pd(_mm256_cvtpd_ps(d));  // rounded to float, as featureValue()
-      const __m256d lt = _mm256_cmp_pd(v, _mm256_set1_pd(double(z.threshold)), _CMP_LT_OQ);
-      sum = _mm256_add_pd(sum, _mm256_blendv_pd(_mm256_set1_pd(z.right), _mm256_set1_pd(z.left), lt));
-    }
-    int pass = _mm256_movemask_pd(_mm256_cmp_pd(sum, stageThreshold, _CMP_NLT_UQ));  // !(sum < threshold)
+    const __m256d sum = stageSum4(sp, st, grids, off, nullptr);
+    int pass = passMask(sum, st.threshold);
     if (n - i < 4) pass &= (1 << (n - i)) - 1;
     if (!pass) continue;
     _mm256_store_pd(sums, sum);
@@ -211,50 +284,104 @@ __attribute__((target("avx2"))) std::size_t stageAvx2(const GridScale& sp, const
   return kept;
 }
 
-bool cpuHasAvx2Gather() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
-#endif
-
-std::size_t runStage(const GridScale& sp, const GridStage& st, const double* const* grids, WindowList& l,
-                     std::size_t n) {
-#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-  if (l.grids <= 8 && vectorScanEnabled() && cpuHasAvx2Gather()) return stageAvx2(sp, st, grids, l, n);
-#endif
-  return stageScalar(sp, st, grids, l, n);
-}
-
-constexpr std::size_t kBand = 48;          // window columns per work item
-constexpr std::size_t kChunkWindows = 512;  // windows per breadth-first chunk (rows of a band)
-
-// Every row of columns [x0, x1) of one scale: hits appended in (row, column) order.
-void scanBand(const GridScale& sp, const double* const* grids, std::size_t ng, std::size_t x0, std::size_t x1,
-              int scaleIndex, WindowList& l, std::vector<RawHit>& hits, std::size_t& stumps) {
-  const std::size_t bw = x1 - x0, rows = sp.win.ys.size();
-  const std::size_t rowsPerChunk = std::max<std::size_t>(1, kChunkWindows / bw);
-  if (l.cap < rowsPerChunk * bw + 4 || l.grids != ng) l.reserve(rowsPerChunk * bw, ng);
-  for (std::size_t y0 = 0; y0 < rows; y0 += rowsPerChunk) {
-    const std::size_t y1 = std::min(rows, y0 + rowsPerChunk);
-    std::size_t n = 0;
-    for (std::size_t yi = y0; yi < y1; ++yi)
-      for (std::size_t xi = x0; xi < x1; ++xi, ++n) {
-        for (std::size_t g = 0; g < ng; ++g) l.offsets(g)[n] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
-        l.xi[n] = static_cast<std::int32_t>(xi);
-        l.yi[n] = static_cast<std::int32_t>(yi);
+// Stage 0 on every window of rows [y0, y1) x columns [x0, x1), four neighbours per step with their
+// origins straight from the plan (no list to build: most windows end here); the survivors become
+// the list. colOfs carries four entries of padding.
+__attribute__((target("avx2"))) std::size_t firstStageAvx2(const GridScale& sp, const void* const* grids,
+                                                           std::size_t x0, std::size_t x1, std::size_t y0,
+                                                           std::size_t y1, WindowList& l) {
+  const std::size_t ng = l.grids;
+  const GridStage& st = sp.stages.front();
+  std::size_t kept = 0;
+  alignas(32) double sums[4];
+  alignas(16) std::int32_t lanes[kMaxVectorGrids][4];
+  for (std::size_t yi = y0; yi < y1; ++yi) {
+    __m128i row[kMaxVectorGrids];
+    for (std::size_t g = 0; g < ng; ++g) row[g] = _mm_set1_epi32(sp.rowOfs[g][yi]);
+    for (std::size_t xi = x0; xi < x1; xi += 4) {
+      __m128i off[kMaxVectorGrids];
+      std::int32_t first[kMaxVectorGrids];
+      for (std::size_t g = 0; g < ng; ++g) {
+        off[g] = _mm_add_epi32(row[g], _mm_loadu_si128(reinterpret_cast<const __m128i*>(sp.colOfs[g].data() + xi)));
+        first[g] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
       }
-    l.pad(n);
-    for (const GridStage& st : sp.stages) {
-      stumps += n * (st.end - st.begin);
-      n = runStage(sp, st, grids, l, n);
-      if (n == 0) break;
+      const __m256d sum = stageSum4(sp, st, grids, off, first);
+      int pass = passMask(sum, st.threshold);
+      if (x1 - xi < 4) pass &= (1 << (x1 - xi)) - 1;
+      if (!pass) continue;
+      _mm256_store_pd(sums, sum);
+      for (std::size_t g = 0; g < ng; ++g) _mm_store_si128(reinterpret_cast<__m128i*>(lanes[g]), off[g]);
+      for (int k = 0; k < 4; ++k) {
+        if (!((pass >> k) & 1)) continue;
+        for (std::size_t g = 0; g < ng; ++g) l.offsets(g)[kept] = lanes[g][k];
+        l.xi[kept] = static_cast<std::int32_t>(xi + std::size_t(k));
+        l.yi[kept] = static_cast<std::int32_t>(yi);
+        l.score[kept] = sums[k];
+        ++kept;
+      }
     }
-    for (std::size_t k = 0; k < n; ++k)
-      hits.push_back(RawHit{Box{double(sp.win.xs[static_cast<std::size_t>(l.xi[k])]),
-                                double(sp.win.ys[static_cast<std::size_t>(l.yi[k])]), double(sp.win.winW),
-                                double(sp.win.winH)},
-                            l.score[k], scaleIndex});
   }
+  l.pad(kept);
+  return kept;
+}
+
+bool useAvx2(std::size_t grids) {
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has && grids <= kMaxVectorGrids && vectorScanEnabled();
+}
+#endif
+
+// Stage 0 one window at a time (the reference form): the list of every window, then its first stage.
+std::size_t firstStageScalar(const GridScale& sp, const void* const* grids, std::size_t x0, std::size_t x1,
+                             std::size_t y0, std::size_t y1, WindowList& l) {
+  std::size_t n = 0;
+  for (std::size_t yi = y0; yi < y1; ++yi)
+    for (std::size_t xi = x0; xi < x1; ++xi, ++n) {
+      for (std::size_t g = 0; g < l.grids; ++g) l.offsets(g)[n] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
+      l.xi[n] = static_cast<std::int32_t>(xi);
+      l.yi[n] = static_cast<std::int32_t>(yi);
+    }
+  l.pad(n);
+  return stageScalar(sp, sp.stages.front(), grids, l, n);
+}
+
+constexpr std::size_t kBand = 48;  // window columns per tile
+constexpr std::size_t kTileWindows = 512;  // windows per tile (rows of a band): breadth-first unit
+
+// One tile: rows [y0, y1) x columns [x0, x1) of one scale, breadth-first; hits appended in (row,
+// column) order.
+void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std::size_t x0, std::size_t x1,
+              std::size_t y0, std::size_t y1, int scaleIndex, WindowList& l, std::vector<RawHit>& hits,
+              std::size_t& stumps) {
+  const std::size_t windows = (x1 - x0) * (y1 - y0);
+  if (l.cap < windows + 4 || l.grids != ng) l.reserve(windows, ng);
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+  const bool vec = useAvx2(ng);
+#else
+  const bool vec = false;
+#endif
+  stumps += windows * (sp.stages.front().end - sp.stages.front().begin);
+  std::size_t n = 0;
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+  if (vec) n = firstStageAvx2(sp, grids, x0, x1, y0, y1, l);
+#endif
+  if (!vec) n = firstStageScalar(sp, grids, x0, x1, y0, y1, l);
+  for (std::size_t s = 1; s < sp.stages.size() && n > 0; ++s) {
+    const GridStage& st = sp.stages[s];
+    stumps += n * (st.end - st.begin);
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+    if (vec) {
+      n = stageAvx2(sp, st, grids, l, n);
+      continue;
+    }
+#endif
+    n = stageScalar(sp, st, grids, l, n);
+  }
+  for (std::size_t k = 0; k < n; ++k)
+    hits.push_back(RawHit{Box{double(sp.win.xs[static_cast<std::size_t>(l.xi[k])]),
+                              double(sp.win.ys[static_cast<std::size_t>(l.yi[k])]), double(sp.win.winW),
+                              double(sp.win.winH)},
+                          l.score[k], scaleIndex});
 }
 
 }  // namespace
@@ -304,24 +431,37 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
     for (ScaleWindows& w : windowScales(cc, in.refWidth(), in.refHeight(), params))
       plans[c].push_back(planScale(cc, in, slots, std::move(w)));
   }
-  // Work items: a band of window columns of one scale of one cascade, all its rows; one index
-  // space for everything so that threads share the work across cascades and scales.
+  // Work items: tiles of one scale of one cascade (a band of window columns, a few rows), all in
+  // one index space so that threads share the work across cascades and scales. Ordered by scale,
+  // then position, then cascade: the models' tiles over the same part of the image follow each
+  // other, so the integral rows one brings into the cache serve the next.
   struct Item {
-    std::size_t cascade, scale, x0, x1;
+    std::size_t cascade, scale, x0, x1, y0, y1;
   };
   std::vector<Item> items;
   for (std::size_t c = 0; c < nc; ++c)
-    for (std::size_t s = 0; s < plans[c].size(); ++s)
-      for (std::size_t x0 = 0; x0 < plans[c][s].win.xs.size(); x0 += kBand)
-        items.push_back(Item{c, s, x0, std::min(plans[c][s].win.xs.size(), x0 + kBand)});
-  std::vector<const double*> grids(ng);
-  for (std::size_t g = 0; g < ng; ++g) grids[g] = in.grids()[g].data.data();
+    for (std::size_t s = 0; s < plans[c].size(); ++s) {
+      const ScaleWindows& w = plans[c][s].win;
+      for (std::size_t x0 = 0; x0 < w.xs.size(); x0 += kBand) {
+        const std::size_t x1 = std::min(w.xs.size(), x0 + kBand);
+        const std::size_t rows = std::max<std::size_t>(1, kTileWindows / (x1 - x0));
+        for (std::size_t y0 = 0; y0 < w.ys.size(); y0 += rows)
+          items.push_back(Item{c, s, x0, x1, y0, std::min(w.ys.size(), y0 + rows)});
+      }
+    }
+  auto place = [&](const Item& it) {
+    const ScaleWindows& w = plans[it.cascade][it.scale].win;
+    return std::make_tuple(it.scale, w.ys[it.y0], w.xs[it.x0], it.cascade);
+  };
+  std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) { return place(a) < place(b); });
+  std::vector<const void*> grids(ng);
+  for (std::size_t g = 0; g < ng; ++g) grids[g] = in.grids()[g].base();
   std::vector<std::vector<RawHit>> hits(items.size());
   std::vector<std::size_t> stumpCount(items.size(), 0);
   auto runItem = [&](std::size_t i, WindowList& l) {
     const Item& it = items[i];
-    scanBand(plans[it.cascade][it.scale], grids.data(), ng, it.x0, it.x1, static_cast<int>(it.scale), l, hits[i],
-             stumpCount[i]);
+    scanTile(plans[it.cascade][it.scale], grids.data(), ng, it.x0, it.x1, it.y0, it.y1, static_cast<int>(it.scale), l,
+             hits[i], stumpCount[i]);
   };
   if (params.threads == 1) {
     WindowList l;
