@@ -67,10 +67,12 @@ namespace bench {
 // detector's scan as negatives (seeded reservoir sample). Features: the pool on a 24-unit grid with
 // types a-e (OpenCV traincascade's BASIC set on 24x24: 162,336 features) - or, for other counts,
 // the first `features` of the 24-grid pool with all ten types. `maxFrames` per drive (0 = all).
-inline RoundData kittiRoundData(std::size_t features, std::size_t samples, std::size_t maxFrames = 0) {
+// The frames of the shared KITTI drives with their intensity layer and labels (`maxFrames` per
+// drive, 0 = all); `keepPixels(i)` false leaves item i with labels and size only.
+template <class KeepPixels>
+std::vector<fusedet::DatasetItem> kittiIntensityItems(std::size_t maxFrames, KeepPixels keepPixels) {
   namespace fs = std::filesystem;
   using namespace fusedet;
-  using namespace fusedet::boosting;
   std::vector<DatasetItem> items;
   for (const char* drive : {"kitti_0009", "kitti"}) {
     const fs::path root = fs::path(FUSEDET_DATA_DIR) / drive;
@@ -81,13 +83,22 @@ inline RoundData kittiRoundData(std::size_t features, std::size_t samples, std::
       DatasetItem item;
       item.id = std::string(drive) + "/" + id;
       item.stack = LayerStack(f.image.cols, f.image.rows);
-      cv::Mat gray;
-      cv::cvtColor(f.image, gray, cv::COLOR_BGR2GRAY);
-      item.stack.set(Layer{"intensity", gray, {}});
+      if (keepPixels(items.size())) {
+        cv::Mat gray;
+        cv::cvtColor(f.image, gray, cv::COLOR_BGR2GRAY);
+        item.stack.set(Layer{"intensity", gray, {}});
+      }
       item.labels = f.labels;
       items.push_back(std::move(item));
     }
   }
+  return items;
+}
+
+inline RoundData kittiRoundData(std::size_t features, std::size_t samples, std::size_t maxFrames = 0) {
+  using namespace fusedet;
+  using namespace fusedet::boosting;
+  const std::vector<DatasetItem> items = kittiIntensityItems(maxFrames, [](std::size_t) { return true; });
   SampleConfig sc;
   sc.className = "car";
   sc.scan.scaleFactor = 1.25;

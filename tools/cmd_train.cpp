@@ -1,6 +1,7 @@
 // fusedet train: trains one class's cascade on a data set (boost/cascade_trainer.h) and writes the
 // model file (boost/model_io.h). Progress: a live status line on a terminal, plain log lines
-// otherwise.
+// otherwise. Started by mpirun/srun, the ranks share the work (docs/distributed.md): each loads
+// the pixels of its own items only, rank 0 prints and writes the model.
 
 #include <unistd.h>
 
@@ -15,6 +16,7 @@
 #include <sstream>
 
 #include "command.h"
+#include "mpi_job.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
@@ -49,6 +51,7 @@ struct TrainOptions {
   bool eval = false;
   double evalScaleFactor = 1.1, evalStep = 2;
   int evalMinNeighbors = 3;
+  double mpiTimeout = 1800;
 };
 
 std::vector<std::string> splitList(const std::string& s) {
@@ -185,7 +188,8 @@ void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
   std::printf("\n");
 }
 
-int runTrain(const TrainOptions& o) {
+int runTrain(const TrainOptions& o, MpiJob* job) {
+  const bool talk = !job || job->rank() == 0;  // only rank 0 prints
   boosting::TrainingConfig c;
   c.className = o.className;
   c.pool.layers = splitList(o.layers);
@@ -233,11 +237,12 @@ int runTrain(const TrainOptions& o) {
                                               : static_cast<std::size_t>(std::lround(double(ids.size()) * o.split));
     trainIds.insert(trainIds.end(), ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n));
     testIds.insert(testIds.end(), ids.begin() + static_cast<std::ptrdiff_t>(n), ids.end());
-    std::fprintf(stderr, "group %s: %zu items, %zu train, %zu held back\n", g.c_str(), ids.size(), n,
-                 ids.size() - n);
+    if (talk)
+      std::fprintf(stderr, "group %s: %zu items, %zu train, %zu held back\n", g.c_str(), ids.size(), n,
+                   ids.size() - n);
   }
   if (trainIds.empty()) throw std::runtime_error(o.data.string() + ": no training items selected");
-  if (!o.testList.empty()) {
+  if (!o.testList.empty() && talk) {
     std::ofstream out(o.testList);
     for (const auto& id : testIds) out << id << "\n";
     if (!out) throw std::runtime_error(o.testList.string() + ": cannot write");
@@ -249,16 +254,28 @@ int runTrain(const TrainOptions& o) {
     const std::string need = l == "hue_distance" ? "hue" : l;
     if (std::find(load.begin(), load.end(), need) == load.end()) load.push_back(need);
   }
+  // A rank loads the pixels of its own items only; of the others just the labels.
+  const boosting::Shard shard = job ? boosting::Shard{job->rank(), job->size()} : boosting::Shard{};
   std::vector<DatasetItem> items;
   const auto t0 = std::chrono::steady_clock::now();
-  for (const auto& id : trainIds) items.push_back(readDatasetItem(o.data, id, load));
-  std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  for (std::size_t i = 0; i < trainIds.size(); ++i)
+    items.push_back(shard.owns(i) ? readDatasetItem(o.data, trainIds[i], load)
+                                  : readDatasetItemLabels(o.data, trainIds[i]));
+  if (talk)
+    std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (job && talk)
+    std::fprintf(stderr, "distributed over %d ranks: item i on rank i %% %d (rank 0 on %s holds %zu items)\n",
+                 job->size(), job->size(), job->hostName().c_str(),
+                 (trainIds.size() + static_cast<std::size_t>(job->size()) - 1) / static_cast<std::size_t>(job->size()));
 
   const bool tty = o.progress == "tty" || (o.progress == "auto" && isatty(STDERR_FILENO));
-  ConsoleProgress progress(tty, o.maxFa, o.targetFa);
+  ConsoleProgress console(tty, o.maxFa, o.targetFa);
+  boosting::NullProgress quiet;
   boosting::TrainingReport report;
-  const boosting::Cascade cascade = boosting::trainCascade(c, items, progress, &report);
+  const boosting::Cascade cascade =
+      boosting::trainCascade(c, items, talk ? static_cast<boosting::ProgressSink&>(console) : quiet, &report, job);
+  if (!talk) return 0;  // rank 0 writes the one model
 
   const std::filesystem::path out = o.out.empty() ? std::filesystem::path(o.className + ".json") : o.out;
   boosting::ModelInfo info = {
@@ -350,6 +367,10 @@ const bool registered = registerCommand(
       app.add_option("--eval-step", o->evalStep, "detection position step for --eval")->capture_default_str();
       app.add_option("--eval-min-neighbors", o->evalMinNeighbors, "grouping: raw hits a detection needs (--eval)")
           ->capture_default_str();
+      app.add_option("--mpi-timeout", o->mpiTimeout,
+                     "[s] under mpirun/srun: end the job when a rank waits this long for the others in one "
+                     "exchange (a rank died or hangs); 0 = wait forever")
+          ->capture_default_str();
       app.add_option("--progress", o->progress, "auto (status line on a terminal), tty or log")
           ->capture_default_str()
           ->check(CLI::IsMember({"auto", "tty", "log"}));
@@ -363,8 +384,26 @@ const bool registered = registerCommand(
           "  fusedet import-kitti --out ds\n"
           "  fusedet train --data ds --class car --out car.json\n"
           "  fusedet train --data ds --class car --layers intensity,hue_distance --types a-f --grid 12\n"
-          "  fusedet train --data ds --groups kitti --train-only kitti_0009 --test-list test.txt --eval");
-      return [o] { return runTrain(*o); };
+          "  fusedet train --data ds --groups kitti --train-only kitti_0009 --test-list test.txt --eval\n"
+          "  mpirun -np 4 --hostfile hosts fusedet train --data ds --class car --out car.json\n\n"
+          "Distributed (docs/distributed.md): started by mpirun or srun, the ranks split the training\n"
+          "items (item i on rank i mod N, each rank reads only its own pixels), build histograms of their\n"
+          "own samples and combine them exactly, so the model file is the same for any number of ranks;\n"
+          "rank 0 prints and writes it. A failing rank ends the whole job with its error. Without a\n"
+          "launcher fusedet trains in-process and loads no MPI library.");
+      return [o] {
+        if (!launchedByMpiLauncher()) return runTrain(*o, nullptr);
+        const std::unique_ptr<MpiJob> job = openMpiJob(o->mpiTimeout);
+        try {
+          return runTrain(*o, job.get());
+        } catch (const std::exception& e) {
+          // The other ranks may be waiting in a collective: end them all, naming this rank.
+          std::fprintf(stderr, "fusedet train: error: rank %d of %d (%s): %s\n", job->rank(), job->size(),
+                       job->hostName().c_str(), e.what());
+          job->abort(1);
+        }
+        return 1;  // not reached: abort() ends the process
+      };
     });
 
 }  // namespace

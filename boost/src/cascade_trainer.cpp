@@ -10,6 +10,8 @@
 
 #include "fusedet/boost/reference_hue.h"
 #include "fusedet/boost/sample_features.h"
+#include "fusedet/boost/sharded_samples.h"
+#include "fusedet/boost/sharded_stage.h"
 
 namespace fusedet::boosting {
 
@@ -60,7 +62,7 @@ double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConf
 }
 
 Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetItem>& train,
-                     ProgressSink& progress, TrainingReport* reportOut) {
+                     ProgressSink& progress, TrainingReport* reportOut, Collective* job) {
   const auto t0 = Clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   TrainingConfig config = configIn;
@@ -71,13 +73,15 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   const std::vector<Feature> pool = generatePool(config.pool);
   report.poolSize = pool.size();
 
+  const Shard shard = job ? Shard{job->rank(), job->size()} : Shard{};
   std::optional<double> refHue;
   const auto& layers = config.pool.layers;
   if (std::find(layers.begin(), layers.end(), "hue_distance") != layers.end())
-    refHue = classReferenceHue(train, config.samples);
+    refHue = job ? shardedReferenceHue(train, config.samples, shard, *job)
+                 : classReferenceHue(train, config.samples);
   report.referenceHue = refHue;
 
-  const TrainingStacks stacks(train, layers, refHue, config.samples);
+  const TrainingStacks stacks(train, layers, refHue, config.samples, shard);
   report.positives = stacks.positives().size();
   if (stacks.positives().empty())
     throw std::runtime_error("no positives of class '" + config.className + "' in " +
@@ -124,9 +128,10 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     ev.maxRounds = config.stage.maxWeak;
 
     // Negatives the cascade still accepts (also measures its false-alarm rate so far).
-    const NegativeHarvest harvest = stacks.harvestNegatives(
-        cascade, stage > config.maxStages ? 0 : wanted, config.seed * 1000003ULL + std::uint64_t(stage),
-        config.threads);
+    const std::size_t want = stage > config.maxStages ? 0 : wanted;
+    const std::uint64_t seed = config.seed * 1000003ULL + std::uint64_t(stage);
+    const NegativeHarvest harvest = job ? shardedHarvest(stacks, cascade, want, seed, config.threads, *job)
+                                        : stacks.harvestNegatives(cascade, want, seed, config.threads);
     const double harvestSeconds = std::chrono::duration<double>(Clock::now() - ts).count();
     if (stage == 1) initialCandidates = std::max<std::size_t>(1, harvest.candidates);
     const double cascadeFa = double(harvest.candidates) / double(initialCandidates);
@@ -162,13 +167,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     }
 
     // Positives the cascade still accepts.
-    std::vector<Sample> samples;
-    if (cascade.stages.empty()) {
-      samples = stacks.positives();
-    } else {
-      for (const Sample& s : stacks.positives())
-        if (evaluateWindow(cascade, stacks.integrals(s.stack), s.window).accepted) samples.push_back(s);
-    }
+    std::vector<Sample> samples = acceptedPositives(stacks, cascade, job);
     const std::size_t positives = samples.size();
     if (positives < config.minPositives) {
       report.stopReason = "too few positives left: the cascade accepts " + std::to_string(positives) +
@@ -184,25 +183,42 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     progress.onProgress(ev);
 
     // The pool on every sample, once per stage.
-    const auto tm = Clock::now();
-    const SampleFeatures values(stacks, pool, samples);
-    const FeatureMatrix matrix = buildFeatureMatrix(
-        pool.size(), n,
-        [&](std::size_t first, std::size_t count, std::span<float> out) { values.block(first, count, out); },
-        config.threads, 1024);
-    const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) { values.feature(f, out); };
-    const auto tb = Clock::now();
-    const double matrixSeconds = std::chrono::duration<double>(tb - tm).count();
     StageConfig sc = config.stage;
     sc.threads = config.threads;
-    const StageResult r = trainStage(matrix, positives, raw, sc, [&](const RoundInfo& info) {
+    const auto onRound = [&](const RoundInfo& info) {
       ev.kind = ProgressKind::kRound;
       ev.round = info.round;
       ev.hitRate = info.hitRate;
       ev.falseAlarm = info.falseAlarm;
       ev.elapsedSeconds = elapsed();
       progress.onProgress(ev);
-    });
+    };
+    const auto tm = Clock::now();
+    std::size_t matrixBytes = 0;
+    double matrixSeconds = 0;
+    auto tb = Clock::now();
+    StageResult r;
+    if (job) {
+      ShardedStage sharded(stacks, pool, samples, positives, *job, config.threads);
+      tb = Clock::now();
+      matrixSeconds = std::chrono::duration<double>(tb - tm).count();
+      matrixBytes = sharded.matrixBytes();
+      r = boostStage(
+          n, positives,
+          [&](std::span<const float> w, std::span<float> chosen) { return sharded.findStump(w, chosen, sc.refineTop); },
+          sc, onRound);
+    } else {
+      const SampleFeatures values(stacks, pool, samples);
+      const FeatureMatrix matrix = buildFeatureMatrix(
+          pool.size(), n,
+          [&](std::size_t first, std::size_t count, std::span<float> out) { values.block(first, count, out); },
+          config.threads, 1024);
+      const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) { values.feature(f, out); };
+      tb = Clock::now();
+      matrixSeconds = std::chrono::duration<double>(tb - tm).count();
+      matrixBytes = matrix.bytes();
+      r = trainStage(matrix, positives, raw, sc, onRound);
+    }
 
     Stage st;
     st.threshold = r.threshold;
@@ -226,7 +242,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     sr.cascadeFalseAlarm = cascadeFa;
     sr.seconds = std::chrono::duration<double>(Clock::now() - ts).count();
     sr.harvestSeconds = harvestSeconds;
-    sr.matrixBytes = matrix.bytes();
+    sr.matrixBytes = matrixBytes;
     sr.matrixSeconds = matrixSeconds;
     sr.boostSeconds = std::chrono::duration<double>(Clock::now() - tb).count();
     report.stages.push_back(sr);

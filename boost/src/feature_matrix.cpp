@@ -111,6 +111,19 @@ void FeatureMatrix::setFeature(std::size_t f, std::span<const float> values) {
   }
 }
 
+void FeatureMatrix::setFeature(std::size_t f, std::span<const float> values, std::span<const float> edges) {
+  if (f >= features_ || values.size() != samples_ || edges.size() >= static_cast<std::size_t>(kMaxBins))
+    throw std::out_of_range("FeatureMatrix::setFeature: feature, sample or edge count out of range");
+  std::uint8_t* out = bins_.data() + f * samples_;
+  for (std::size_t i = 0; i < samples_; ++i) {
+    const float v = values[i];
+    const auto bin = std::isnan(v) ? edges.size()
+                                   : static_cast<std::size_t>(std::upper_bound(edges.begin(), edges.end(), v) -
+                                                              edges.begin());
+    out[i] = static_cast<std::uint8_t>(bin);
+  }
+}
+
 FeatureMatrix buildFeatureMatrix(std::size_t features, std::size_t samples,
                                  const FeatureBlockFn& values, int threads, std::size_t block) {
   FeatureMatrix m(features, samples);

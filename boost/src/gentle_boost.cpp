@@ -16,10 +16,8 @@ double stageThreshold(std::vector<double> scores, double minHit) {
   return t - 1e-9 * std::max(1.0, std::fabs(t));
 }
 
-StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
-                       const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound) {
-  const std::size_t n = m.samples();
+StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
+                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
@@ -30,14 +28,10 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
   std::vector<float> values(n);
-  StumpSearchOptions search;
-  search.threads = config.threads;
-  search.refineTop = config.refineTop;
   StageResult result;
   for (int round = 1; round <= config.maxWeak; ++round) {
     for (std::size_t i = 0; i < n; ++i) wf[i] = static_cast<float>(w[i]);
-    const FittedStump s = findBestStump(m, positives, wf, rawValues, search);
-    rawValues(s.feature, values);
+    const FittedStump s = find(wf, values);
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
       const double f = s(values[i]);
@@ -63,6 +57,22 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
     }
   }
   return result;
+}
+
+StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
+                       const FeatureValuesFn& rawValues, const StageConfig& config,
+                       const std::function<void(const RoundInfo&)>& onRound) {
+  StumpSearchOptions search;
+  search.threads = config.threads;
+  search.refineTop = config.refineTop;
+  return boostStage(
+      m.samples(), positives,
+      [&](std::span<const float> weights, std::span<float> chosen) {
+        const FittedStump s = findBestStump(m, positives, weights, rawValues, search);
+        rawValues(s.feature, chosen);
+        return s;
+      },
+      config, onRound);
 }
 
 }  // namespace fusedet::boosting

@@ -10,7 +10,8 @@ SampleFeatures::SampleFeatures(const TrainingStacks& stacks, std::span<const Fea
                                std::span<const Sample> samples)
     : stacks_(stacks), pool_(pool), samples_(samples) {
   const std::size_t n = samples.size();
-  layers_ = stacks.size() ? stacks.integrals(0).size() : 0;
+  // Layer count of the samples' own stacks (in a sharded job other ranks' stacks are empty).
+  layers_ = n ? stacks.integrals(samples[0].stack).size() : 0;
   windows_.resize(n * layers_);
   for (std::size_t i = 0; i < n; ++i) {
     const IntegralStack& is = stacks.integrals(samples[i].stack);

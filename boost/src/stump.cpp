@@ -22,19 +22,6 @@ namespace {
 constexpr int kBins = FeatureMatrix::kMaxBins;
 constexpr int kLanes = 4;  // independent sub-histograms: repeated bins do not serialise the adds
 
-// Total order of candidates: larger gain first, then smaller feature, then smaller bin.
-bool better(const SplitCandidate& a, const SplitCandidate& b) {
-  if (a.gain != b.gain) return a.gain > b.gain;
-  if (a.feature != b.feature) return a.feature < b.feature;
-  return a.bin < b.bin;
-}
-
-void keepTop(std::vector<SplitCandidate>& top, const SplitCandidate& c, std::size_t k) {
-  if (top.size() == k && !better(c, top.back())) return;
-  top.insert(std::upper_bound(top.begin(), top.end(), c, better), c);
-  if (top.size() > k) top.pop_back();
-}
-
 // Adds weights[i] into hist[i % 4][bins[i]] for i in [begin, end).
 inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t begin, std::size_t end,
                        float (*hist)[kBins]) {
@@ -173,6 +160,26 @@ SplitCandidate scanBins(std::size_t feature, float (*pos)[kBins], float (*neg)[k
 
 }  // namespace
 
+bool betterSplit(const SplitCandidate& a, const SplitCandidate& b) {
+  if (a.gain != b.gain) return a.gain > b.gain;
+  if (a.feature != b.feature) return a.feature < b.feature;
+  return a.bin < b.bin;
+}
+
+void keepBestSplits(std::vector<SplitCandidate>& top, const SplitCandidate& c, std::size_t k) {
+  if (top.size() == k && !betterSplit(c, top.back())) return;
+  top.insert(std::upper_bound(top.begin(), top.end(), c, betterSplit), c);
+  if (top.size() > k) top.pop_back();
+}
+
+std::vector<std::size_t> refineOrder(const std::vector<SplitCandidate>& candidates) {
+  std::vector<std::size_t> features;
+  for (const auto& c : candidates) features.push_back(c.feature);
+  if (features.empty()) features.push_back(0);
+  std::sort(features.begin(), features.end());
+  return features;
+}
+
 std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t positives,
                                              std::span<const float> weights, std::size_t k,
                                              int threads) {
@@ -203,14 +210,14 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
                             accumulatePair(b0, b1, weights.data(), positives, n, neg[0], neg[1]);
                             for (int q = 0; q < 2; ++q) {
                               const SplitCandidate s = scanBins(f + std::size_t(q), pos[q], neg[q]);
-                              if (s.gain >= 0) keepTop(top, s, k);
+                              if (s.gain >= 0) keepBestSplits(top, s, k);
                             }
                           }
                           if (f < end) {
                             accumulate(m.row(f), weights.data(), 0, positives, pos[0]);
                             accumulate(m.row(f), weights.data(), positives, n, neg[0]);
                             const SplitCandidate s = scanBins(f, pos[0], neg[0]);
-                            if (s.gain >= 0) keepTop(top, s, k);
+                            if (s.gain >= 0) keepBestSplits(top, s, k);
                           }
                           perChunk[c] = std::move(top);
                         }
@@ -218,7 +225,7 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
   });
   std::vector<SplitCandidate> top;
   for (const auto& chunk : perChunk)
-    for (const SplitCandidate& s : chunk) keepTop(top, s, k);
+    for (const SplitCandidate& s : chunk) keepBestSplits(top, s, k);
   return top;
 }
 
@@ -289,13 +296,7 @@ FittedStump findBestStump(const FeatureMatrix& m, std::size_t positives,
   std::vector<float> values(m.samples());
   FittedStump best;
   bool have = false;
-  // Candidates come in feature order among equal gains; refine in ascending feature order so the
-  // exact tie-break (smaller feature wins) does not depend on the binned ranking.
-  std::vector<std::size_t> features;
-  for (const auto& c : candidates) features.push_back(c.feature);
-  if (features.empty()) features.push_back(0);
-  std::sort(features.begin(), features.end());
-  for (std::size_t f : features) {
+  for (std::size_t f : refineOrder(candidates)) {
     rawValues(f, values);
     const FittedStump s = fitStumpExact(f, values, weights, positives);
     if (!have || s.error < best.error) {

@@ -46,26 +46,28 @@ DatasetItem flipItem(const DatasetItem& item) {
 
 TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                const std::vector<std::string>& layers,
-                               std::optional<double> referenceHue, const SampleConfig& config)
-    : config_(config) {
-  auto addStack = [&](const DatasetItem& item) {
+                               std::optional<double> referenceHue, const SampleConfig& config, Shard shard)
+    : config_(config), shard_(shard) {
+  auto addStack = [&](const DatasetItem& item, std::size_t itemIndex) {
     const auto index = static_cast<std::uint32_t>(integrals_.size());
+    const bool mine = shard_.owns(itemIndex);
     try {
-      integrals_.emplace_back(item.stack, layers, referenceHue);
+      integrals_.push_back(mine ? IntegralStack(item.stack, layers, referenceHue) : IntegralStack());
     } catch (const std::exception& e) {
       throw std::runtime_error("training item " + item.id + ": " + e.what());
     }
+    owner_.push_back(static_cast<int>(itemIndex % static_cast<std::size_t>(shard_.ranks)));
     labels_.push_back(item.labels);
     for (const Label& l : item.labels)
       if (isPositiveLabel(l, config_)) positives_.push_back(Sample{index, l.box});
   };
-  for (const DatasetItem& item : items) addStack(item);
+  for (std::size_t i = 0; i < items.size(); ++i) addStack(items[i], i);
   originals_ = integrals_.size();
   if (config_.flipPositives)
-    for (const DatasetItem& item : items)
-      if (std::any_of(item.labels.begin(), item.labels.end(),
+    for (std::size_t i = 0; i < items.size(); ++i)
+      if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
                       [&](const Label& l) { return isPositiveLabel(l, config_); }))
-        addStack(flipItem(item));
+        addStack(flipItem(items[i]), i);
 }
 
 double TrainingStacks::positiveAspect() const {
@@ -76,8 +78,7 @@ double TrainingStacks::positiveAspect() const {
   return a[a.size() / 2];
 }
 
-NegativeHarvest TrainingStacks::harvestNegatives(const Cascade& cascade, std::size_t wanted,
-                                                 std::uint64_t seed, int threads) const {
+Detector TrainingStacks::harvestDetector(const Cascade& cascade) {
   Cascade scanWith = cascade;
   if (scanWith.stages.empty()) {
     // No stage yet: a one-stump stage that accepts every window, so the scan visits exactly the
@@ -85,19 +86,31 @@ NegativeHarvest TrainingStacks::harvestNegatives(const Cascade& cascade, std::si
     scanWith.features = {Feature{FeatureType::kEdgeHorizontal, Box{0, 0, 1, 1}, 0}};
     scanWith.stages = {Stage{{Stump{0, 0.0, 1.0, 1.0}}, 0.0}};
   }
-  const Detector detector(scanWith);
+  return Detector(scanWith);
+}
+
+std::vector<Box> TrainingStacks::candidateWindows(const Detector& detector, std::size_t s, int threads,
+                                                  std::size_t* scanned) const {
   ScanParams params = config_.scan;
   params.threads = threads;
+  ScanStats stats;
+  const std::vector<RawHit> hits = detector.scan(integrals_.at(s), params, &stats);
+  *scanned += stats.windows;
+  std::vector<Box> out;
+  for (const RawHit& hit : hits)
+    if (isNegativeWindow(hit.box, labels_[s], config_)) out.push_back(hit.box);
+  return out;
+}
+
+NegativeHarvest TrainingStacks::harvestNegatives(const Cascade& cascade, std::size_t wanted,
+                                                 std::uint64_t seed, int threads) const {
+  const Detector detector = harvestDetector(cascade);
   NegativeHarvest h;
   std::mt19937_64 rng(seed);
   for (std::size_t s = 0; s < originals_; ++s) {
-    ScanStats stats;
-    const std::vector<RawHit> hits = detector.scan(integrals_[s], params, &stats);
-    h.windowsScanned += stats.windows;
-    for (const RawHit& hit : hits) {
-      if (!isNegativeWindow(hit.box, labels_[s], config_)) continue;
+    for (const Box& box : candidateWindows(detector, s, threads, &h.windowsScanned)) {
       const std::size_t c = h.candidates++;
-      const Sample sample{static_cast<std::uint32_t>(s), hit.box};
+      const Sample sample{static_cast<std::uint32_t>(s), box};
       if (c < wanted) {
         h.samples.push_back(sample);
       } else {
@@ -107,6 +120,20 @@ NegativeHarvest TrainingStacks::harvestNegatives(const Cascade& cascade, std::si
     }
   }
   return h;
+}
+
+std::vector<std::size_t> reservoirSlots(std::size_t candidates, std::size_t wanted, std::uint64_t seed) {
+  std::vector<std::size_t> slots;
+  std::mt19937_64 rng(seed);
+  for (std::size_t c = 0; c < candidates; ++c) {
+    if (c < wanted) {
+      slots.push_back(c);
+    } else {
+      const std::uint64_t j = rng() % (c + 1);  // the draws of harvestNegatives()
+      if (j < wanted) slots[j] = c;
+    }
+  }
+  return slots;
 }
 
 }  // namespace fusedet::boosting

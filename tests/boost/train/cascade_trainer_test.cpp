@@ -12,63 +12,14 @@
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/sample_features.h"
+#include "synthetic_scenes.h"
 
 using namespace fusedet;
 using namespace fusedet::boosting;
+using fusedet::synthetic::scene;
+using fusedet::synthetic::scenes;
 
 namespace {
-
-// Synthetic scenes: noisy background, "cars" = 36x24 boxes with a bright upper half and a dark
-// lower half (hue 200 inside, 40 outside), "vans" = uniformly bright boxes (a hard negative),
-// a DontCare region in some scenes.
-DatasetItem scene(unsigned seed, int cars, bool withHue) {
-  std::mt19937 rng(seed);
-  cv::Mat img(120, 200, CV_8U);
-  cv::randu(img, 60, 140);
-  cv::Mat hue(120, 200, CV_32F, cv::Scalar(40.f));
-  DatasetItem item;
-  item.id = "synthetic/" + std::to_string(seed);
-  item.group = "synthetic";
-  std::uniform_int_distribution<int> x(0, 200 - 40), y(0, 120 - 28);
-  std::vector<cv::Rect> placed;
-  auto free = [&](const cv::Rect& r) {
-    for (const auto& p : placed)
-      if ((r & p).area() > 0) return false;
-    return true;
-  };
-  for (int k = 0, tries = 0; k < cars + 1 && tries < 100; ++tries) {
-    const int w = 34 + int(rng() % 5), h = 24;
-    cv::Rect r(x(rng), y(rng), w, h);
-    if (!free(r)) continue;
-    placed.push_back(r);
-    Label l;
-    l.box = Box{double(r.x), double(r.y), double(r.width), double(r.height)};
-    if (k < cars) {
-      img(cv::Rect(r.x, r.y, r.width, r.height / 2)) += cv::Scalar(70);
-      img(cv::Rect(r.x, r.y + r.height / 2, r.width, r.height / 2)) -= cv::Scalar(50);
-      hue(r).setTo(200.f);
-      l.className = "car";
-      l.sourceClass = "Car";
-    } else {
-      img(r) += cv::Scalar(60);
-      l.className = "van";
-      l.sourceClass = "Van";
-    }
-    item.labels.push_back(l);
-    ++k;
-  }
-  if (seed % 3 == 0) {
-    Label dc;
-    dc.box = Box{0, 0, 30, 30};
-    dc.ignore = true;
-    dc.sourceClass = "DontCare";
-    item.labels.push_back(dc);
-  }
-  item.stack = LayerStack(200, 120);
-  item.stack.set(Layer{"intensity", img, {}});
-  if (withHue) item.stack.set(Layer{"hue", hue, {}});
-  return item;
-}
 
 TrainingConfig smallConfig() {
   TrainingConfig c;
@@ -84,12 +35,6 @@ TrainingConfig smallConfig() {
   c.stage.maxWeak = 20;
   c.seed = 5;
   return c;
-}
-
-std::vector<DatasetItem> scenes(int n, bool withHue) {
-  std::vector<DatasetItem> items;
-  for (int i = 0; i < n; ++i) items.push_back(scene(100 + unsigned(i), i % 4 == 3 ? 0 : 2, withHue));
-  return items;
 }
 
 class Recorder : public ProgressSink {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "fusedet/boost/cascade.h"
+#include "fusedet/boost/collective.h"
 #include "fusedet/boost/feature_pool.h"
 #include "fusedet/boost/gentle_boost.h"
 #include "fusedet/boost/training_set.h"
@@ -98,8 +99,15 @@ class NullProgress : public ProgressSink {
 
 // Trains; throws std::invalid_argument for a bad config and std::runtime_error when the data has
 // no positives of the class or lacks a selected layer (the message names the item).
+//
+// With `job` (collective.h) training is sharded over its ranks, each calling this with the same
+// config and item list: item i's pixels are needed only on rank i % job->size() (the others may
+// hold just labels and reference size, readDatasetItemLabels()); see sharded_samples.h and
+// sharded_stage.h. Every rank returns the same cascade, identical for any number of ranks (but
+// not necessarily equal to the in-process trainer's: sharded_stage.h says why). Progress events
+// are sent on every rank (callers show rank 0's); stage times and matrix sizes are this rank's.
 Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem>& train,
-                     ProgressSink& progress, TrainingReport* report = nullptr);
+                     ProgressSink& progress, TrainingReport* report = nullptr, Collective* job = nullptr);
 
 // Reference hue of config.className's positives in `items` (reference_hue.h), from their hue
 // layer. Throws std::runtime_error when no positive has hue values.

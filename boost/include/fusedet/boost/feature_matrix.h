@@ -26,6 +26,11 @@ class FeatureMatrix {
   // when there are at most kMaxBins distinct values). Thread-safe for distinct f.
   void setFeature(std::size_t f, std::span<const float> values);
 
+  // Bins the raw values of feature f with given edges (binEdges(); at most kMaxBins - 1): bin =
+  // number of edges <= value, NaN in the last bin. Sharded training bins every rank's samples with
+  // edges from one global subsample (sharded_stage.h). Thread-safe for distinct f.
+  void setFeature(std::size_t f, std::span<const float> values, std::span<const float> edges);
+
   std::size_t features() const { return features_; }
   std::size_t samples() const { return samples_; }
   const std::uint8_t* row(std::size_t f) const { return bins_.data() + f * samples_; }

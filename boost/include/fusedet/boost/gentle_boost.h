@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <span>
 #include <vector>
 
 #include "fusedet/boost/feature_matrix.h"
@@ -35,6 +36,16 @@ struct StageResult {
   double hitRate = 0, falseAlarm = 0;
   bool reachedFalseAlarm = false;   // false: stopped at maxWeak
 };
+
+// One round's weak learner for boostStage(): the best stump for the sample weights (float, sample
+// order) and, in `chosenValues`, the raw values of its feature on every sample.
+using StumpFinder = std::function<FittedStump(std::span<const float> weights, std::span<float> chosenValues)>;
+
+// The Gentle AdaBoost loop over `samples` samples ([0, positives) are positives) with any stump
+// finder: trainStage() searches one in-process matrix, sharded_stage.h one sharded over ranks.
+StageResult boostStage(std::size_t samples, std::size_t positives, const StumpFinder& find,
+                       const StageConfig& config,
+                       const std::function<void(const RoundInfo&)>& onRound = {});
 
 // Samples [0, positives) of `m` are positives. rawValues gives the raw values of a matrix row
 // (exact refinement and the update use them). onRound (optional) sees every round.

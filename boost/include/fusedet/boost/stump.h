@@ -36,6 +36,14 @@ struct SplitCandidate {
   double gain = -1;
 };
 
+// The order of candidates: larger gain first, then smaller feature, then smaller bin.
+bool betterSplit(const SplitCandidate& a, const SplitCandidate& b);
+// Inserts c into `top` (kept sorted by betterSplit) and keeps the best k.
+void keepBestSplits(std::vector<SplitCandidate>& top, const SplitCandidate& c, std::size_t k);
+// The features of `candidates` in the order they are refined exactly: ascending, so the exact
+// tie-break (smaller feature wins) does not depend on the binned ranking; {0} when empty.
+std::vector<std::size_t> refineOrder(const std::vector<SplitCandidate>& candidates);
+
 // Best binned splits over the whole matrix, best first (gain descending, feature ascending).
 // Samples [0, positives) are positives, the rest negatives: the trainer orders them so, which
 // lets the histogram loop add one weight per sample without looking at a label.

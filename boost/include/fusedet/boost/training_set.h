@@ -51,15 +51,31 @@ struct NegativeHarvest {
   std::size_t candidates = 0;       // of those: label-free windows the cascade accepts
 };
 
+// Which rank of a sharded training job holds an item's pixels: item i lives on rank i % ranks.
+struct Shard {
+  int rank = 0, ranks = 1;
+  bool owns(std::size_t item) const { return static_cast<int>(item % static_cast<std::size_t>(ranks)) == rank; }
+};
+
+// Global candidate index held by each of the `wanted` reservoir slots after Algorithm R ran over
+// `candidates` candidates with mt19937_64(seed): the same draws harvestNegatives() makes, so a
+// sharded harvest (sharded_samples.h) picks the same windows without streaming them in one place.
+std::vector<std::size_t> reservoirSlots(std::size_t candidates, std::size_t wanted, std::uint64_t seed);
+
 class TrainingStacks {
  public:
   // Integrates `layers` of every item (hue_distance derived with referenceHue); stacks holding
   // positives get a mirrored copy when config.flipPositives. Throws when an item lacks a layer.
+  // With a shard, only the items this rank owns (and their mirrored copies) are integrated; the
+  // others need only labels and reference size (readDatasetItemLabels()).
   TrainingStacks(const std::vector<DatasetItem>& items, const std::vector<std::string>& layers,
-                 std::optional<double> referenceHue, const SampleConfig& config);
+                 std::optional<double> referenceHue, const SampleConfig& config, Shard shard = {});
 
   std::size_t size() const { return integrals_.size(); }
   const IntegralStack& integrals(std::size_t i) const { return integrals_.at(i); }
+  // Rank holding stack i (mirrored copies live with their original).
+  int owner(std::size_t i) const { return owner_.at(i); }
+  const Shard& shard() const { return shard_; }
   const std::vector<Sample>& positives() const { return positives_; }
   const SampleConfig& config() const { return config_; }
   std::size_t originalStacks() const { return originals_; }  // [0, originals) are the items
@@ -72,12 +88,21 @@ class TrainingStacks {
   NegativeHarvest harvestNegatives(const Cascade& cascade, std::size_t wanted, std::uint64_t seed,
                                    int threads) const;
 
+  // The detector the harvest scans with (one accepting every window while `cascade` is empty).
+  static Detector harvestDetector(const Cascade& cascade);
+  // Label-free windows of original stack s that `detector` accepts, in scan order; adds the
+  // windows visited to *scanned.
+  std::vector<Box> candidateWindows(const Detector& detector, std::size_t s, int threads,
+                                    std::size_t* scanned) const;
+
  private:
-  std::vector<IntegralStack> integrals_;
+  std::vector<IntegralStack> integrals_;  // empty for stacks of other ranks
+  std::vector<int> owner_;
   std::vector<Labels> labels_;  // per stack (mirrored for flipped copies)
   std::vector<Sample> positives_;
   std::size_t originals_ = 0;
   SampleConfig config_;
+  Shard shard_;
 };
 
 // Horizontally mirrored copy of a stack (every layer and mask) and its labels.

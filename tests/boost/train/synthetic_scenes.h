@@ -1,0 +1,72 @@
+#pragma once
+// Synthetic training scenes shared by the trainer tests and the dataset writer of the MPI tests.
+
+#include <opencv2/core.hpp>
+
+#include <random>
+#include <string>
+#include <vector>
+
+#include "fusedet/core/dataset.h"
+
+namespace fusedet::synthetic {
+
+// Synthetic scenes: noisy background, "cars" = 36x24 boxes with a bright upper half and a dark
+// lower half (hue 200 inside, 40 outside), "vans" = uniformly bright boxes (a hard negative),
+// a DontCare region in some scenes.
+inline DatasetItem scene(unsigned seed, int cars, bool withHue) {
+  std::mt19937 rng(seed);
+  cv::Mat img(120, 200, CV_8U);
+  cv::randu(img, 60, 140);
+  cv::Mat hue(120, 200, CV_32F, cv::Scalar(40.f));
+  DatasetItem item;
+  item.id = "synthetic/" + std::to_string(seed);
+  item.group = "synthetic";
+  std::uniform_int_distribution<int> x(0, 200 - 40), y(0, 120 - 28);
+  std::vector<cv::Rect> placed;
+  auto free = [&](const cv::Rect& r) {
+    for (const auto& p : placed)
+      if ((r & p).area() > 0) return false;
+    return true;
+  };
+  for (int k = 0, tries = 0; k < cars + 1 && tries < 100; ++tries) {
+    const int w = 34 + int(rng() % 5), h = 24;
+    cv::Rect r(x(rng), y(rng), w, h);
+    if (!free(r)) continue;
+    placed.push_back(r);
+    Label l;
+    l.box = Box{double(r.x), double(r.y), double(r.width), double(r.height)};
+    if (k < cars) {
+      img(cv::Rect(r.x, r.y, r.width, r.height / 2)) += cv::Scalar(70);
+      img(cv::Rect(r.x, r.y + r.height / 2, r.width, r.height / 2)) -= cv::Scalar(50);
+      hue(r).setTo(200.f);
+      l.className = "car";
+      l.sourceClass = "Car";
+    } else {
+      img(r) += cv::Scalar(60);
+      l.className = "van";
+      l.sourceClass = "Van";
+    }
+    item.labels.push_back(l);
+    ++k;
+  }
+  if (seed % 3 == 0) {
+    Label dc;
+    dc.box = Box{0, 0, 30, 30};
+    dc.ignore = true;
+    dc.sourceClass = "DontCare";
+    item.labels.push_back(dc);
+  }
+  item.stack = LayerStack(200, 120);
+  item.stack.set(Layer{"intensity", img, {}});
+  if (withHue) item.stack.set(Layer{"hue", hue, {}});
+  return item;
+}
+
+inline std::vector<DatasetItem> scenes(int n, bool withHue) {
+  std::vector<DatasetItem> items;
+  for (int i = 0; i < n; ++i) items.push_back(scene(100 + unsigned(i), i % 4 == 3 ? 0 : 2, withHue));
+  return items;
+}
+
+}  // namespace fusedet::synthetic
