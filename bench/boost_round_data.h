@@ -95,6 +95,29 @@ std::vector<fusedet::DatasetItem> kittiIntensityItems(std::size_t maxFrames, Kee
   return items;
 }
 
+// The cascade whose (empty) scan yields the negatives: 24 px high, the positives' aspect ratio.
+inline fusedet::boosting::Cascade negativeScan(const fusedet::boosting::TrainingStacks& stacks) {
+  fusedet::boosting::Cascade scan;
+  scan.layers = {"intensity"};
+  scan.windowHeight = 24;
+  scan.windowWidth = static_cast<int>(std::lround(24 * stacks.positiveAspect()));
+  return scan;
+}
+
+// The grid-24 pool on `layers`: types a-e for 162,336 features (OpenCV's BASIC set), else the
+// first `features` of all ten types.
+inline std::vector<fusedet::boosting::Feature> roundPool(std::size_t features, const std::vector<std::string>& layers) {
+  using namespace fusedet::boosting;
+  PoolConfig pc;
+  pc.grid = 24;
+  pc.layers = layers;
+  pc.types = features == 162336 ? parseFeatureTypes("a-e") : std::vector<FeatureType>{};
+  std::vector<Feature> pool = generatePool(pc);
+  if (pool.size() < features) throw std::runtime_error("pool has only " + std::to_string(pool.size()) + " features");
+  pool.resize(features);
+  return pool;
+}
+
 inline RoundData kittiRoundData(std::size_t features, std::size_t samples, std::size_t maxFrames = 0) {
   using namespace fusedet;
   using namespace fusedet::boosting;
@@ -107,20 +130,9 @@ inline RoundData kittiRoundData(std::size_t features, std::size_t samples, std::
   std::vector<Sample> all = stacks.positives();
   if (all.size() > samples / 3) all.resize(samples / 3);
   const std::size_t positives = all.size();
-  Cascade scan;
-  scan.layers = layers;
-  scan.windowHeight = 24;
-  scan.windowWidth = static_cast<int>(std::lround(24 * stacks.positiveAspect()));
-  const NegativeHarvest neg = stacks.harvestNegatives(scan, samples - positives, 1, 0);
+  const NegativeHarvest neg = stacks.harvestNegatives(negativeScan(stacks), samples - positives, 1, 0);
   all.insert(all.end(), neg.samples.begin(), neg.samples.end());
-
-  PoolConfig pc;
-  pc.grid = 24;
-  pc.layers = layers;
-  pc.types = features == 162336 ? parseFeatureTypes("a-e") : std::vector<FeatureType>{};
-  std::vector<Feature> pool = generatePool(pc);
-  if (pool.size() < features) throw std::runtime_error("pool has only " + std::to_string(pool.size()) + " features");
-  pool.resize(features);
+  const std::vector<Feature> pool = roundPool(features, layers);
 
   RoundData d;
   d.features = features;

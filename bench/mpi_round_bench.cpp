@@ -94,20 +94,10 @@ int worker(const Args& a) {
   std::vector<Sample> samples = stacks.positives();
   if (samples.size() > a.samples / 3) samples.resize(a.samples / 3);
   const std::size_t positives = samples.size();
-  Cascade scan;
-  scan.layers = layers;
-  scan.windowHeight = 24;
-  scan.windowWidth = static_cast<int>(std::lround(24 * stacks.positiveAspect()));
-  const NegativeHarvest neg = shardedHarvest(stacks, scan, a.samples - positives, 1, a.threads, *job);
+  const NegativeHarvest neg =
+      shardedHarvest(stacks, bench::negativeScan(stacks), a.samples - positives, 1, a.threads, *job);
   samples.insert(samples.end(), neg.samples.begin(), neg.samples.end());
-
-  PoolConfig pc;
-  pc.grid = 24;
-  pc.layers = layers;
-  pc.types = a.features == 162336 ? parseFeatureTypes("a-e") : std::vector<FeatureType>{};
-  std::vector<Feature> pool = generatePool(pc);
-  if (pool.size() < a.features) throw std::runtime_error("pool has only " + std::to_string(pool.size()));
-  pool.resize(a.features);
+  const std::vector<Feature> pool = bench::roundPool(a.features, layers);
 
   const auto t0 = Clock::now();
   ShardedStage stage(stacks, pool, samples, positives, *job, a.threads);

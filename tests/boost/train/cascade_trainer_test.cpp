@@ -18,24 +18,9 @@ using namespace fusedet;
 using namespace fusedet::boosting;
 using fusedet::synthetic::scene;
 using fusedet::synthetic::scenes;
+using fusedet::synthetic::smallConfig;
 
 namespace {
-
-TrainingConfig smallConfig() {
-  TrainingConfig c;
-  c.className = "car";
-  c.pool.grid = 6;
-  c.pool.layers = {"intensity"};
-  c.samples.baseWindowHeight = 12;
-  c.samples.minPositiveHeight = 20;
-  c.samples.scan.scaleFactor = 1.25;
-  c.samples.scan.step = 2;
-  c.maxStages = 3;
-  c.negativesPerStage = 300;
-  c.stage.maxWeak = 20;
-  c.seed = 5;
-  return c;
-}
 
 class Recorder : public ProgressSink {
  public:

@@ -113,20 +113,13 @@ std::vector<T> onRanks(int ranks, const std::vector<DatasetItem>& items,
   return results;
 }
 
-TrainingConfig smallConfig() {
-  TrainingConfig c;
-  c.className = "car";
-  c.pool.grid = 6;
+// Two layers, 2 stages of several rounds each (not one lucky stump), one thread per rank.
+TrainingConfig shardedConfig() {
+  TrainingConfig c = synthetic::smallConfig();
   c.pool.layers = {"intensity", "hue_distance"};
-  c.samples.baseWindowHeight = 12;
-  c.samples.minPositiveHeight = 20;
-  c.samples.scan.scaleFactor = 1.25;
-  c.samples.scan.step = 2;
   c.maxStages = 2;
-  c.negativesPerStage = 300;
   c.stage.maxWeak = 15;
-  c.stage.maxFalseAlarm = 0.01;  // several rounds per stage, not one lucky stump
-  c.seed = 5;
+  c.stage.maxFalseAlarm = 0.01;
   c.threads = 1;
   return c;
 }
@@ -170,7 +163,7 @@ TEST(ShardedTraining, HarvestPicksTheInProcessWindowsForAnyRankCount) {
 
 TEST(ShardedTraining, SameModelForOneTwoAndThreeRanks) {
   const auto items = synthetic::scenes(8, true);
-  const TrainingConfig config = smallConfig();
+  const TrainingConfig config = shardedConfig();
   std::vector<std::string> models;
   for (int ranks = 1; ranks <= 3; ++ranks) {
     const auto texts = onRanks<std::string>(ranks, items, [&](const std::vector<DatasetItem>& mine, Collective& c) {

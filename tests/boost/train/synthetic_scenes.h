@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/core/dataset.h"
 
 namespace fusedet::synthetic {
@@ -67,6 +68,23 @@ inline std::vector<DatasetItem> scenes(int n, bool withHue) {
   std::vector<DatasetItem> items;
   for (int i = 0; i < n; ++i) items.push_back(scene(100 + unsigned(i), i % 4 == 3 ? 0 : 2, withHue));
   return items;
+}
+
+// A small, fast training configuration for these scenes (grid 6, 12 px windows, 3 stages).
+inline boosting::TrainingConfig smallConfig() {
+  boosting::TrainingConfig c;
+  c.className = "car";
+  c.pool.grid = 6;
+  c.pool.layers = {"intensity"};
+  c.samples.baseWindowHeight = 12;
+  c.samples.minPositiveHeight = 20;
+  c.samples.scan.scaleFactor = 1.25;
+  c.samples.scan.step = 2;
+  c.maxStages = 3;
+  c.negativesPerStage = 300;
+  c.stage.maxWeak = 20;
+  c.seed = 5;
+  return c;
 }
 
 }  // namespace fusedet::synthetic
