@@ -44,6 +44,8 @@ struct TiltOptions {
   std::string fault = "none";
   double faultAt = 5.0;
   std::string interface = "can0";
+  int sdoTimeoutMs = 200;
+  int heartbeatMs = 0;  // 0 = from the config
 };
 
 TiltDriveConfig driveConfig(const TiltOptions& o, std::string* iface = nullptr) {
@@ -58,10 +60,20 @@ TiltDriveConfig driveConfig(const TiltOptions& o, std::string* iface = nullptr) 
   c.units.countsPerRev = t.countsPerRev;
   c.units.gearRatio = t.gearRatio;
   c.units.zeroOffsetCounts = static_cast<std::int32_t>(t.zeroOffsetCounts);
-  c.heartbeatMs = t.heartbeatMs;
+  c.heartbeatMs = o.heartbeatMs > 0 ? o.heartbeatMs : t.heartbeatMs;
+  c.sdoTimeout = std::chrono::milliseconds(o.sdoTimeoutMs);
   if (const std::string why = c.validate(); !why.empty()) throw std::runtime_error(why);
   if (iface) *iface = o.can.empty() ? t.interface : o.can;
   return c;
+}
+
+std::string jsonEscape(const std::string& in) {
+  std::string out;
+  for (char c : in) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
+  }
+  return out;
 }
 
 void openBus(SocketCanBus& bus, const std::string& iface) {
@@ -74,6 +86,26 @@ void printSample(const drivers::TiltSample& s, bool json) {
                 s.velocity / kDeg);
   else
     std::printf("%s %9.4f deg %8.3f deg/s\n", s.stamp.toString().c_str(), s.angle / kDeg, s.velocity / kDeg);
+}
+
+// One greppable line per drive event, on stdout (samples, if asked for, are interleaved).
+void printEvent(const TiltEvent& e) {
+  switch (e.kind) {
+    case TiltEvent::Kind::kOperationEnabled:
+      std::printf("tilt: operation enabled after %.0f ms\n", e.seconds * 1e3);
+      break;
+    case TiltEvent::Kind::kSweep:
+      std::printf("tilt: sweep %llu from %.3f to %.3f deg, %llu samples\n", (unsigned long long)e.index, e.minRad / kDeg,
+                  e.maxRad / kDeg, (unsigned long long)e.samples);
+      break;
+    case TiltEvent::Kind::kFault:
+      std::printf("tilt: fault: %s\n", e.cause.c_str());
+      break;
+    case TiltEvent::Kind::kRecovered:
+      std::printf("tilt: recovered in %.0f ms\n", e.seconds * 1e3);
+      break;
+  }
+  std::fflush(stdout);
 }
 
 void printCounters(const TiltDriveCounters& c) {
@@ -122,7 +154,7 @@ int runDrive(const TiltOptions& o, const std::function<void(TiltDrive&)>& begin,
   TiltDrive drive(bus, c, [&](const drivers::TiltSample& s) {
     if (o.samples || o.json) printSample(s, o.json);
   });
-  drive.setFaultHandler([](const std::string& cause) { std::fprintf(stderr, "tilt: fault: %s\n", cause.c_str()); });
+  drive.setEventHandler([](const TiltEvent& e) { printEvent(e); });
   std::signal(SIGINT, onTiltSignal);
   std::signal(SIGTERM, onTiltSignal);
   std::atomic<bool> stopRunner{false};
@@ -186,11 +218,16 @@ int runMonitor(const TiltOptions& o) {
     }
     ++n;
     log.write(*f);
-    std::printf("%s %-22s %s\n", f->stamp.toString().c_str(), f->toString().c_str(), describeFrame(*f).c_str());
+    if (o.json)
+      std::printf("{\"stamp\":%s,\"kernel_stamp\":%s,\"frame\":\"%s\",\"text\":\"%s\"}\n", f->stamp.toString().c_str(),
+                  f->kernelStamp ? "true" : "false", f->toString().c_str(), jsonEscape(describeFrame(*f)).c_str());
+    else
+      std::printf("%s %-22s %s\n", f->stamp.toString().c_str(), f->toString().c_str(), describeFrame(*f).c_str());
     std::fflush(stdout);
   }
   if (auto r = log.close(); !r) throw std::runtime_error(r.error().message());
-  std::fprintf(stderr, "tilt monitor: %ld frames, %llu error frames\n", n, (unsigned long long)bus.counters().errorFrames);
+  std::fprintf(stderr, "tilt monitor: %ld frames, %llu error frames, %llu without a kernel stamp\n", n,
+               (unsigned long long)bus.counters().errorFrames, (unsigned long long)bus.counters().userStamps);
   return 0;
 }
 
@@ -204,6 +241,7 @@ int runSimulate(const TiltOptions& o) {
   if (!kind) throw std::runtime_error(kind.error().message());
   s.fault = *kind;
   s.faultAtSeconds = o.faultAt;
+  s.onEvent = printEvent;
   auto r = drivers::canopen::sim::runNodSimulation(s, [&](const drivers::TiltSample& x) {
     if (o.samples || o.json) printSample(x, o.json);
   });
@@ -226,6 +264,9 @@ const bool registered = registerCommand(
       app.add_option("--min-deg", o->minDeg, "lower nodding limit [deg] (default: tilt.min_deg)");
       app.add_option("--max-deg", o->maxDeg, "upper nodding limit [deg] (default: tilt.max_deg)");
       app.add_option("--speed", o->speedDegS, "nodding speed [deg/s] (default: tilt.speed_deg_s)");
+      app.add_option("--heartbeat-ms", o->heartbeatMs, "heartbeat period asked of the drive; lost after 3 (default: tilt.heartbeat_ms)")
+          ->check(CLI::Range(1, 65535));
+      app.add_option("--sdo-timeout-ms", o->sdoTimeoutMs, "SDO response timeout [ms]")->check(CLI::Range(1, 60000))->capture_default_str();
       CLI::App* status = app.add_subcommand("status", "read the drive's identity, state, mode, position and error code over SDO (changes nothing)");
       CLI::App* nod = app.add_subcommand("nod", "bring the drive up and nod until --sweeps/--duration/Ctrl-C; then halt and disable it");
       nod->add_option("--sweeps", o->sweeps, "stop after N sweeps (0 = no limit)")->capture_default_str();
@@ -240,6 +281,7 @@ const bool registered = registerCommand(
       monitor->add_option("--count", o->count, "stop after N frames (0 = no limit)")->capture_default_str();
       monitor->add_option("--duration", o->duration, "stop after S seconds (0 = no limit)")->capture_default_str();
       monitor->add_option("--candump", o->candump, "also write the frames as a candump -l log");
+      monitor->add_flag("--json", o->json, "one JSON object per frame: stamp, kernel_stamp (true = the kernel's receive stamp), frame, text");
       CLI::App* simulate = app.add_subcommand(
           "simulate", "drive + simulated motor on an in-process bus in simulated time; all traffic as a candump log");
       simulate->add_option("--sweeps", o->sweeps, "sweeps to nod")->capture_default_str();
@@ -255,7 +297,11 @@ const bool registered = registerCommand(
           "otherwise). nod/home: NMT reset node, boot-up, SDO configuration (heartbeat, TPDO1 = position +\n"
           "statusword on every SYNC at 100 Hz, profile position mode, speed, acceleration 60 deg/s^2),\n"
           "NMT start, CiA 402 state machine to operation enabled; faults are reported on stderr and\n"
-          "recovered. Counters go to stderr at the end. simulate runs in simulated time (seconds of nodding\n"
+          "recovered. nod/home print one line per event on stdout: 'tilt: operation enabled after N ms',\n"
+          "'tilt: sweep I from A to B deg, N samples', 'tilt: fault: CAUSE', 'tilt: recovered in N ms'.\n"
+          "Stamps: SocketCAN frames carry the kernel's receive stamp (SO_TIMESTAMPING, else SIOCGSTAMP)\n"
+          "moved to CLOCK_MONOTONIC; monitor --json says per frame whether it was the kernel's.\n"
+          "Counters go to stderr at the end. simulate runs in simulated time (seconds of nodding\n"
           "take milliseconds); stamps in the log start at 1000 s.\n"
           "Examples:\n"
           "  tilt-sim --can vcan0 --node 5 &  fusedet tilt --can vcan0 --node 5 nod --sweeps 4 --samples\n"

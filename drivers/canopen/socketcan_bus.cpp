@@ -173,7 +173,9 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::microseconds timeout) {
       timeval tv{};
       if (::ioctl(fd_.get(), SIOCGSTAMP, &tv) == 0) realNs = std::int64_t{tv.tv_sec} * 1'000'000'000 + tv.tv_usec * 1000;
     }
-    f.stamp = realNs != 0 ? realtimeToMonotonic(realNs) : Stamp::now();
+    f.kernelStamp = realNs != 0;
+    f.stamp = f.kernelStamp ? realtimeToMonotonic(realNs) : Stamp::now();
+    if (!f.kernelStamp) ++counters_.userStamps;
     ++counters_.framesRx;
     if (f.error) ++counters_.errorFrames;
     notify(f, FrameDirection::kRx);

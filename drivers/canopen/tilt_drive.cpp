@@ -54,6 +54,11 @@ void TiltDrive::setFaultHandler(FaultHandler h) {
   onFault_ = std::move(h);
 }
 
+void TiltDrive::setEventHandler(EventHandler h) {
+  std::lock_guard lock(mutex_);
+  onEvent_ = std::move(h);
+}
+
 double TiltDrive::minRad() const { return config_.minDeg * kDeg; }
 double TiltDrive::maxRad() const { return config_.maxDeg * kDeg; }
 
@@ -147,6 +152,10 @@ void TiltDrive::fault(const std::string& cause, bool reachable) {
     heartbeatFault_ = cause.find("heartbeat") != std::string::npos;
     spdlog::warn("tilt {} node {}: fault: {}", bus_.name(), config_.node, cause);
     if (onFault_) onFault_(cause);
+    TiltEvent e;
+    e.kind = TiltEvent::Kind::kFault;
+    e.cause = cause;
+    emit(e);
   } else {
     spdlog::info("tilt {} node {}: recovery failed: {}", bus_.name(), config_.node, cause);
   }
@@ -212,6 +221,17 @@ void TiltDrive::enableStep() {
         ++counters_.recoveries;
         counters_.lastRecoverySeconds = static_cast<double>(now_ - faultAt_) * 1e-9;
         spdlog::info("tilt {} node {}: recovered in {:.3f} s", bus_.name(), config_.node, counters_.lastRecoverySeconds);
+        TiltEvent e;
+        e.kind = TiltEvent::Kind::kRecovered;
+        e.seconds = counters_.lastRecoverySeconds;
+        emit(e);
+      }
+      if (!everEnabled_) {
+        everEnabled_ = true;
+        TiltEvent e;
+        e.kind = TiltEvent::Kind::kOperationEnabled;
+        e.seconds = static_cast<double>(now_ - startedAt_) * 1e-9;
+        emit(e);
       }
       positioned_ = false;
       beginMove();
@@ -250,6 +270,8 @@ void TiltDrive::beginMove() {
   }
   moveTarget_ = config_.units.toCounts(target);
   move_ = MoveStep::kCommanding;
+  sweepSamples_ = 0;
+  sweepMin_ = sweepMax_ = lastSample_ ? lastSample_->angle : 0.0;
   ackPolls_ = 0;
   sdo_.download(od::kTargetPosition, 0, static_cast<std::uint32_t>(moveTarget_), 4, expectOk());
   sdo_.download(od::kControlword, 0, cw::kEnableOperation | cw::kNewSetPoint | cw::kChangeImmediately, 2, expectOk());
@@ -317,6 +339,9 @@ void TiltDrive::handleTpdo(const CanFrame& f) {
     sample.velocity = (sample.angle - lastSample_->angle) / (static_cast<double>(f.stamp - lastSample_->stamp) * 1e-9);
   lastSample_ = sample;
   ++counters_.samples;
+  ++sweepSamples_;
+  sweepMin_ = std::min(sweepMin_, sample.angle);
+  sweepMax_ = std::max(sweepMax_, sample.angle);
   if (onSample_) onSample_(sample);
 
   if (phase_ != TiltPhase::kRunning) return;
@@ -330,7 +355,16 @@ void TiltDrive::handleTpdo(const CanFrame& f) {
     move_ = MoveStep::kNone;
     ++counters_.moves;
     if (motion_ == Motion::kNod) {
-      if (positioned_) ++counters_.sweeps;
+      if (positioned_) {
+        ++counters_.sweeps;
+        TiltEvent e;
+        e.kind = TiltEvent::Kind::kSweep;
+        e.index = counters_.sweeps;
+        e.minRad = sweepMin_;
+        e.maxRad = sweepMax_;
+        e.samples = sweepSamples_;
+        emit(e);
+      }
       positioned_ = true;
       nextToMax_ = !nextToMax_;
       beginMove();
@@ -360,6 +394,7 @@ void TiltDrive::poll(Stamp now) {
     startRequested_ = false;
     setFilters();
     phase_ = TiltPhase::kBooting;
+    startedAt_ = now;
     phaseDeadline_ = now + ns(config_.bootTimeout);
     nextSync_ = now;
     heartbeatArmed_ = false;

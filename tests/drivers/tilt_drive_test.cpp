@@ -30,11 +30,13 @@ struct Rig {
   sim::MotorSimulator motor{motorBus, sim::MotorSimOptions{}};
   std::vector<TiltSample> samples;
   std::vector<std::string> faults;
+  std::vector<TiltEvent> events;
   TiltDrive drive;
 
   explicit Rig(TiltDriveConfig c = {})
       : config(c), drive(masterBus, c, [this](const TiltSample& s) { samples.push_back(s); }) {
     drive.setFaultHandler([this](const std::string& cause) { faults.push_back(cause); });
+    drive.setEventHandler([this](const TiltEvent& e) { events.push_back(e); });
     net.attach(motor, motorBus);
     net.attach(drive, masterBus);
   }
@@ -147,6 +149,19 @@ TEST(TiltDrive, TenSweepsFollowTheCommandedProfile) {
   for (const auto& x : s) vmax = std::max(vmax, std::abs(x.velocity));
   EXPECT_NEAR(vmax / kDeg, rig.config.speedDegS, 0.2);
   EXPECT_EQ(rig.drive.counters().faults, 0u);
+  // One event per sweep, its extremes the ends, and one start-up event.
+  int sweepEvents = 0, enabled = 0;
+  for (const TiltEvent& e : rig.events) {
+    if (e.kind == TiltEvent::Kind::kOperationEnabled) ++enabled;
+    if (e.kind != TiltEvent::Kind::kSweep) continue;
+    ++sweepEvents;
+    EXPECT_EQ(e.index, static_cast<std::uint64_t>(sweepEvents));
+    EXPECT_NEAR(e.minRad, lo, halfCount);
+    EXPECT_NEAR(e.maxRad, hi, halfCount);
+    EXPECT_NEAR(static_cast<double>(e.samples), 425.0, 5.0);  // 4.25 s at 100 Hz
+  }
+  EXPECT_EQ(enabled, 1);
+  EXPECT_GE(sweepEvents, 10);
 }
 
 namespace {

@@ -17,6 +17,18 @@ Result<FaultKind> parseFaultKind(const std::string& name) {
   return makeError(std::errc::invalid_argument, "unknown fault '" + name + "' (none emcy silence stall sdo-abort bus-off)");
 }
 
+std::string_view toString(FaultKind k) {
+  switch (k) {
+    case FaultKind::kNone: return "none";
+    case FaultKind::kEmcy: return "emcy";
+    case FaultKind::kSilence: return "silence";
+    case FaultKind::kStall: return "stall";
+    case FaultKind::kSdoAbort: return "sdo-abort";
+    case FaultKind::kBusOff: return "bus-off";
+  }
+  return "unknown";
+}
+
 Result<NodSimulationReport> runNodSimulation(const NodSimulationOptions& o,
                                              const std::function<void(const TiltSample&)>& onSample) {
   if (const std::string why = o.drive.validate(); !why.empty()) return makeError(std::errc::invalid_argument, why);
@@ -38,6 +50,7 @@ Result<NodSimulationReport> runNodSimulation(const NodSimulationOptions& o,
   mo.node = o.drive.node;
   MotorSimulator motor(motorBus, mo);
   TiltDrive drive(masterBus, o.drive, onSample);
+  if (o.onEvent) drive.setEventHandler(o.onEvent);
   net.attach(motor, motorBus);
   net.attach(drive, masterBus);
   const Stamp start = net.now();

@@ -14,6 +14,7 @@ namespace fusedet::drivers::canopen::sim {
 
 enum class FaultKind { kNone, kEmcy, kSilence, kStall, kSdoAbort, kBusOff };
 Result<FaultKind> parseFaultKind(const std::string& name);  // none emcy silence stall sdo-abort bus-off
+std::string_view toString(FaultKind k);
 
 struct NodSimulationOptions {
   TiltDriveConfig drive;
@@ -24,6 +25,7 @@ struct NodSimulationOptions {
   FaultKind fault = FaultKind::kNone;
   double faultAtSeconds = 5.0;    // after the start
   double limitSeconds = 0;        // give up after this much simulated time (0 = from the sweeps)
+  TiltDrive::EventHandler onEvent;  // start-up, sweeps, faults, recoveries
 };
 
 struct NodSimulationReport {

@@ -28,6 +28,7 @@ struct CanBusCounters {
   std::uint64_t errorFrames = 0;  // SocketCAN error frames received (bus-off, error passive, ...)
   std::uint64_t txFailures = 0;   // sends refused (buffer full, bus-off, interface down)
   std::uint64_t timeouts = 0;     // receive() calls that ended without a frame
+  std::uint64_t userStamps = 0;   // SocketCAN frames the kernel gave no stamp for (stamped here instead)
 };
 
 enum class FrameDirection { kRx, kTx };

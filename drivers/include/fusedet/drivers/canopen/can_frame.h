@@ -19,6 +19,7 @@ struct CanFrame {
   std::uint8_t len = 0;        // 0..8
   std::array<std::uint8_t, 8> data{};
   Stamp stamp;                 // reception (kernel) or send time, CLOCK_MONOTONIC
+  bool kernelStamp = false;    // stamp came from the kernel (SocketCAN receive), not a clock read here
 
   static CanFrame make(std::uint32_t id, std::initializer_list<std::uint8_t> bytes);
   bool sameContent(const CanFrame& o) const;  // everything but the stamp

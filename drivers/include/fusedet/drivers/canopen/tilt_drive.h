@@ -71,13 +71,25 @@ struct TiltDriveCounters {
   TiltPhase phase = TiltPhase::kIdle;
 };
 
+// What happened, for logs and command lines (one line each).
+struct TiltEvent {
+  enum class Kind { kOperationEnabled, kSweep, kFault, kRecovered } kind = Kind::kFault;
+  double seconds = 0;         // kOperationEnabled: since start(); kRecovered: since the fault
+  std::uint64_t index = 0;    // kSweep: sweep number (1, 2, ...)
+  double minRad = 0, maxRad = 0;  // kSweep: extreme sampled angles of the sweep
+  std::uint64_t samples = 0;  // kSweep: TiltSamples during the sweep
+  std::string cause;          // kFault
+};
+
 class TiltDrive : public CanNode {
  public:
   using SampleHandler = std::function<void(const TiltSample&)>;
   using FaultHandler = std::function<void(const std::string& cause)>;
+  using EventHandler = std::function<void(const TiltEvent&)>;
 
   TiltDrive(CanBus& bus, TiltDriveConfig config, SampleHandler onSample = {});
   void setFaultHandler(FaultHandler h);
+  void setEventHandler(EventHandler h);
 
   // Bring the drive up (reset node first) and then nod; hold(angle) instead holds one angle.
   void start();
@@ -151,6 +163,14 @@ class TiltDrive : public CanNode {
   int ackPolls_ = 0;
 
   std::optional<TiltSample> lastSample_;
+  EventHandler onEvent_;
+  Stamp startedAt_{};
+  bool everEnabled_ = false;
+  double sweepMin_ = 0, sweepMax_ = 0;
+  std::uint64_t sweepSamples_ = 0;
+  void emit(const TiltEvent& e) {
+    if (onEvent_) onEvent_(e);
+  }
 };
 
 }  // namespace fusedet::drivers::canopen
