@@ -109,6 +109,8 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     Section s = top.child("socket");
     s.read("path", c.socket.path);
     s.readRange("max_clients", c.socket.maxClients, 1, 1024);
+    s.readRange("max_request_bytes", c.socket.maxRequestBytes, 64, 1 << 20);
+    s.readRange("client_queue", c.socket.clientQueue, 1, 1 << 16);
     s.finish();
   }
   {
@@ -177,7 +179,7 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.readRange("scale_factor", c.detection.scaleFactor, 1.01, 4.0);
     s.read("min_size", c.detection.minSize);
     s.read("max_size", c.detection.maxSize);
-    s.readRange("step", c.detection.step, 0.001, 1.0);
+    s.readRange("step", c.detection.step, 0.1, 64.0);
     s.readOneOf<std::string>("grouping", c.detection.grouping, {"nms", "opencv"});
     s.readRange("nms_iou", c.detection.nmsIou, 0.0, 1.0);
     s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
@@ -215,7 +217,9 @@ std::string dumpConfig(const Config& c) {
       << c.logLevel << YAML::EndMap;
   out << YAML::Key << "socket" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "path" << YAML::Value << c.socket.path;
-  out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients << YAML::EndMap;
+  out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients;
+  out << YAML::Key << "max_request_bytes" << YAML::Value << c.socket.maxRequestBytes;
+  out << YAML::Key << "client_queue" << YAML::Value << c.socket.clientQueue << YAML::EndMap;
   out << YAML::Key << "laser" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "device" << YAML::Value << c.laser.device;
   out << YAML::Key << "baud" << YAML::Value << c.laser.baud;

@@ -23,6 +23,8 @@ struct Config {
   struct Socket {
     std::string path = "/run/fusedet/fusedet.sock";
     int maxClients = 16;
+    int maxRequestBytes = 4096;
+    int clientQueue = 256;
   } socket;
 
   struct Laser {
@@ -68,13 +70,15 @@ struct Config {
   } fusion;
 
   struct Detection {
-    std::vector<std::string> models{"/usr/share/fusedet/models/car.json"};
+    // Defaults equal boosting::ScanParams{} and GroupParams{} (one meaning for every key).
+    std::vector<std::string> models{"/usr/share/fusedet/models/car.json", "/usr/share/fusedet/models/bike.json",
+                                    "/usr/share/fusedet/models/person.json"};
     double scaleFactor = 1.1;
-    std::array<int, 2> minSize{24, 24};
+    std::array<int, 2> minSize{0, 0};
     std::array<int, 2> maxSize{0, 0};
-    double step = 0.05;
-    std::string grouping = "nms";
-    double nmsIou = 0.4;
+    double step = 2;  // base-window pixels, scaled with the window (ScanParams::step)
+    std::string grouping = "opencv";
+    double nmsIou = 0.5;
     int minNeighbors = 3;
     int threads = 0;
   } detection;

@@ -1,0 +1,133 @@
+#pragma once
+// Pipeline: sensor messages -> sweep assembly -> pairing -> fusion (fusion thread) -> every class
+// (detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
+// own threads and push into the sensor queue through the SensorSink interface; both queues are
+// bounded and drop their oldest item when full (counted), so no producer ever waits. When
+// detection falls behind, the stack queue (2 deep) drops the oldest stack.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include "fusedet/core/detection.h"
+#include "fusedet/core/layer_stack.h"
+#include "fusedet/daemon/bounded_queue.h"
+#include "fusedet/daemon/localize.h"
+#include "fusedet/daemon/source.h"
+#include "fusedet/daemon/stack_detector.h"
+#include "fusedet/daemon/stats.h"
+#include "fusedet/fusion/fuser.h"
+#include "fusedet/fusion/pairing.h"
+#include "fusedet/fusion/sweep_assembler.h"
+
+namespace fusedet::daemon {
+
+struct LocatedDetection {
+  Detection detection;               // detection.position = the robot-frame position, if any
+  std::optional<Position> position;  // camera and robot frame, range, cells used
+};
+
+// Everything the detection thread found in one stack.
+struct StackResult {
+  std::uint64_t stackId = 0;
+  Stamp sweepStart, sweepEnd;  // the sweep's first and last beam
+  Stamp frameStamp;            // the camera frame
+  Stamp sensorStamp;           // the newest sensor stamp that went into the stack
+  Stamp detectedAt;            // when detection finished
+  double fuseMs = 0, detectMs = 0;
+  std::vector<LocatedDetection> detections;
+};
+
+struct PipelineSetup {
+  std::shared_ptr<const fusion::Fuser> fuser;  // camera model, extrinsics, laser layer settings
+  fusion::SweepConfig sweep;
+  std::int64_t maxPairSkewNs = 150'000'000;
+  std::size_t sensorQueueCapacity = 512;  // messages between sources and fusion
+  std::size_t stackQueueCapacity = 2;     // fused stacks waiting for detection
+};
+
+struct PipelineCounters {
+  QueueCounters sensorQueue, stackQueue;  // stackQueue.dropped = stacks detection never saw
+  fusion::SweepStats sweeps;
+  std::uint64_t scenes = 0;         // pre-paired scenes received
+  std::uint64_t unpaired = 0;       // sweeps without a frame within the skew
+  std::uint64_t decodeErrors = 0;   // camera frames that did not decode
+  std::uint64_t fuseErrors = 0;
+  std::uint64_t stacksFused = 0;
+  std::uint64_t stacksDetected = 0;
+  std::uint64_t detectErrors = 0;
+  std::uint64_t detections = 0;
+  double scanRate = 0, tiltRate = 0, frameRate = 0, stackRate = 0;  // per second, last 5 s
+  double lastFuseMs = 0, lastDetectMs = 0;
+};
+
+class Pipeline : public SensorSink {
+ public:
+  using ResultHandler = std::function<void(std::shared_ptr<const StackResult>)>;
+
+  // onResult is called on the detection thread; it must not block (the server only queues).
+  Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> detector, ResultHandler onResult);
+  ~Pipeline() override;
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+
+  void start();
+  // Refuses new messages, lets fusion and detection finish what is queued until `deadline`
+  // (steady clock), then abandons the rest and joins the threads.
+  void stop(std::chrono::steady_clock::time_point deadline);
+
+  // Swaps the detector between two stacks (SIGHUP reload).
+  void setDetector(std::shared_ptr<const StackDetector> detector);
+  std::shared_ptr<const StackDetector> detector() const;
+
+  // SensorSink: never block.
+  void onScan(drivers::LaserScan scan) override;
+  void onTilt(drivers::TiltSample sample) override;
+  void onFrame(drivers::CameraFrame frame) override;
+  void onScene(PairedScene scene) override;
+
+  PipelineCounters counters() const;
+  // Steady-clock ns of the last sign of life of the fusion and detection threads (each wakes at
+  // least every 200 ms while idle). A thread stuck in one stack stops advancing its beat.
+  std::int64_t fusionBeatNs() const { return fusionBeat_.load(); }
+  std::int64_t detectionBeatNs() const { return detectionBeat_.load(); }
+
+ private:
+  using SensorMessage = std::variant<drivers::LaserScan, drivers::TiltSample, drivers::CameraFrame, PairedScene>;
+  struct FusedStack {
+    LayerStack stack;
+    Stamp sweepStart, sweepEnd, frameStamp;
+    double fuseMs = 0;
+  };
+
+  void fusionLoop();
+  void detectionLoop();
+  void handle(SensorMessage& message);
+  void fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFrame& frame);
+
+  PipelineSetup setup_;
+  ResultHandler onResult_;
+  mutable std::mutex detectorMutex_;
+  std::shared_ptr<const StackDetector> detector_;
+
+  BoundedQueue<SensorMessage> sensorQueue_;
+  BoundedQueue<FusedStack> stackQueue_;
+  fusion::SweepAssembler assembler_;   // fusion thread only
+  fusion::FramePairer pairer_;         // fusion thread only
+  std::uint64_t nextStackId_ = 0;      // fusion thread only
+
+  std::thread fusionThread_, detectionThread_;
+  std::atomic<bool> abandon_{false}, detectionDone_{false};
+  std::atomic<std::int64_t> fusionBeat_{0}, detectionBeat_{0};
+
+  mutable std::mutex countersMutex_;
+  PipelineCounters counters_;
+  RateMeter scanRate_, tiltRate_, frameRate_, stackRate_;
+};
+
+}  // namespace fusedet::daemon

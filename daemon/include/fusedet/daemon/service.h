@@ -1,0 +1,84 @@
+#pragma once
+// Service: the running daemon - sources, pipeline and socket server wired together, with the
+// answers to `hello` and `status`, reload (SIGHUP) and the liveness the systemd watchdog is fed
+// from. run.h drives it from signals and sd_notify.
+
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "fusedet/daemon/config.h"
+#include "fusedet/daemon/pipeline.h"
+#include "fusedet/daemon/server.h"
+#include "fusedet/daemon/source.h"
+#include "fusedet/daemon/stack_detector.h"
+#include "fusedet/drivers/unique_fd.h"
+
+namespace fusedet::daemon {
+
+struct ServiceParts {
+  Config config;
+  std::filesystem::path configFile;  // reload() reads it again; empty = reload(Config) only
+  std::shared_ptr<const fusion::Fuser> fuser;
+  std::shared_ptr<const StackDetector> detector;
+  std::vector<std::unique_ptr<Source>> sources;
+  drivers::UniqueFd listener;  // bound and listening
+  std::string mode = "live";   // "live" | "replay" | "scenes"
+};
+
+// Fusion settings (camera calibration file, extrinsics, laser layers) of a config. Throws
+// std::runtime_error naming the calibration file on failure.
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config);
+fusion::SweepConfig sweepConfigFrom(const Config& config);
+ServerLimits serverLimitsFrom(const Config& config);
+// Models resolve relative to the config file's folder.
+std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
+
+class Service {
+ public:
+  explicit Service(ServiceParts parts);
+  ~Service();
+  Service(const Service&) = delete;
+  Service& operator=(const Service&) = delete;
+
+  // Starts the server, the pipeline threads and the sources: afterwards requests are served.
+  void start();
+  // Stops the sources, drains the pipeline and flushes clients, all by `deadline`.
+  void stop(std::chrono::steady_clock::time_point deadline);
+
+  // Re-reads the config file and the models. Returns "" when applied; else why the old
+  // configuration is kept. Detection settings, models, socket limits and the log level take
+  // effect at once; other changed keys are named in the log as needing a restart.
+  std::string reload();
+  std::string reload(const Config& next);
+
+  nlohmann::json hello() const;
+  nlohmann::json status() const;
+  // True when the fusion, detection and server threads all showed life within maxAgeNs.
+  bool alive(std::int64_t maxAgeNs) const;
+  // One line for systemd's STATUS=.
+  std::string summary() const;
+
+  Pipeline& pipeline() { return *pipeline_; }
+  Server& server() { return *server_; }
+  Config config() const;
+
+ private:
+  mutable std::mutex mutex_;  // config_, lastReloadError_
+  Config config_;
+  std::filesystem::path configFile_;
+  std::string mode_;
+  std::string lastReloadError_;
+  std::uint64_t reloads_ = 0;
+  std::vector<std::unique_ptr<Source>> sources_;
+  std::unique_ptr<Server> server_;
+  std::unique_ptr<Pipeline> pipeline_;
+  std::int64_t startedNs_ = 0;
+  bool started_ = false;
+};
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,50 @@
+#pragma once
+// StackDetector: the pipeline's one, narrow detection call - every configured class on one
+// LayerStack. CascadeSet is today's implementation (one boosting::Detector per model file, each
+// with its own reference hue from the model); a faster multi-class detector slots in behind the
+// same interface.
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/detector.h"
+#include "fusedet/boost/grouping.h"
+#include "fusedet/core/detection.h"
+#include "fusedet/core/layer_stack.h"
+#include "fusedet/daemon/config.h"
+
+namespace fusedet::daemon {
+
+class StackDetector {
+ public:
+  virtual ~StackDetector() = default;
+  // Detections of every class, boxes in the stack's reference pixels. Called from one thread.
+  virtual std::vector<Detection> detect(const LayerStack& stack) const = 0;
+  // Class names, in model order.
+  virtual std::vector<std::string> classes() const = 0;
+};
+
+// The config's detection section in the library's terms (one meaning for every key).
+boosting::ScanParams scanParamsFrom(const Config::Detection& d);
+boosting::GroupParams groupParamsFrom(const Config::Detection& d);
+
+class CascadeSet : public StackDetector {
+ public:
+  // Loads every model file (relative paths against `base`); throws std::runtime_error naming the
+  // file and the problem (missing, malformed, invalid cascade, two models of one class).
+  CascadeSet(const Config::Detection& settings, const std::filesystem::path& base = {});
+
+  std::vector<Detection> detect(const LayerStack& stack) const override;
+  std::vector<std::string> classes() const override;
+  const std::vector<std::filesystem::path>& files() const { return files_; }
+
+ private:
+  std::vector<boosting::Detector> detectors_;
+  std::vector<std::filesystem::path> files_;
+  boosting::ScanParams scan_;
+  boosting::GroupParams group_;
+};
+
+}  // namespace fusedet::daemon

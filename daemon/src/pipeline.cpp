@@ -1,0 +1,206 @@
+#include "fusedet/daemon/pipeline.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "fusedet/fusion/frame_decode.h"
+
+namespace fusedet::daemon {
+namespace {
+constexpr std::chrono::milliseconds kIdleWake{200};  // threads show liveness at least this often
+}
+
+Pipeline::Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> detector, ResultHandler onResult)
+    : setup_(std::move(setup)),
+      onResult_(std::move(onResult)),
+      detector_(std::move(detector)),
+      sensorQueue_(setup_.sensorQueueCapacity),
+      stackQueue_(setup_.stackQueueCapacity),
+      assembler_(setup_.sweep),
+      pairer_(setup_.maxPairSkewNs) {
+  if (!setup_.fuser) throw std::invalid_argument("Pipeline: no fuser");
+  if (!detector_) throw std::invalid_argument("Pipeline: no detector");
+}
+
+Pipeline::~Pipeline() { stop(std::chrono::steady_clock::now()); }
+
+void Pipeline::start() {
+  const std::int64_t now = Stamp::now().ns;
+  fusionBeat_ = now;
+  detectionBeat_ = now;
+  fusionThread_ = std::thread([this] { fusionLoop(); });
+  detectionThread_ = std::thread([this] { detectionLoop(); });
+}
+
+void Pipeline::stop(std::chrono::steady_clock::time_point deadline) {
+  // Fusion drains the closed sensor queue and then closes the stack queue; detection ends when
+  // that is empty. Whatever is still queued at the deadline is abandoned.
+  sensorQueue_.close();
+  while (detectionThread_.joinable() && !detectionDone_ && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  abandon_ = true;
+  stackQueue_.close();
+  if (fusionThread_.joinable()) fusionThread_.join();
+  if (detectionThread_.joinable()) detectionThread_.join();
+}
+
+void Pipeline::setDetector(std::shared_ptr<const StackDetector> detector) {
+  std::lock_guard lock(detectorMutex_);
+  detector_ = std::move(detector);
+}
+
+std::shared_ptr<const StackDetector> Pipeline::detector() const {
+  std::lock_guard lock(detectorMutex_);
+  return detector_;
+}
+
+void Pipeline::onScan(drivers::LaserScan scan) {
+  scanRate_.tick(Stamp::now().ns);
+  sensorQueue_.push(std::move(scan));
+}
+void Pipeline::onTilt(drivers::TiltSample sample) {
+  tiltRate_.tick(Stamp::now().ns);
+  sensorQueue_.push(sample);
+}
+void Pipeline::onFrame(drivers::CameraFrame frame) {
+  frameRate_.tick(Stamp::now().ns);
+  sensorQueue_.push(std::move(frame));
+}
+void Pipeline::onScene(PairedScene scene) {
+  const std::int64_t now = Stamp::now().ns;
+  scanRate_.tick(now);
+  frameRate_.tick(now);
+  sensorQueue_.push(std::move(scene));
+}
+
+void Pipeline::fusionLoop() {
+  while (!abandon_) {
+    fusionBeat_ = Stamp::now().ns;
+    auto message = sensorQueue_.pop(kIdleWake);
+    if (!message) {
+      if (sensorQueue_.closed()) break;
+      continue;
+    }
+    try {
+      handle(*message);
+    } catch (const std::exception& e) {
+      std::lock_guard lock(countersMutex_);
+      ++counters_.fuseErrors;
+      spdlog::warn("fusion: {}", e.what());
+    }
+  }
+  stackQueue_.close();
+}
+
+void Pipeline::handle(SensorMessage& message) {
+  if (auto* scan = std::get_if<drivers::LaserScan>(&message)) {
+    assembler_.addScan(*scan);
+  } else if (auto* tilt = std::get_if<drivers::TiltSample>(&message)) {
+    assembler_.addTilt(*tilt);
+  } else if (auto* frame = std::get_if<drivers::CameraFrame>(&message)) {
+    pairer_.addFrame(std::move(*frame));
+  } else if (auto* scene = std::get_if<PairedScene>(&message)) {
+    {
+      std::lock_guard lock(countersMutex_);
+      ++counters_.scenes;
+    }
+    fuseAndQueue(scene->sweep, scene->frame);
+  }
+  for (const fusion::Sweep& sweep : assembler_.takeSweeps())
+    if (auto frame = pairer_.pair(sweep)) fuseAndQueue(sweep, *frame);
+  std::lock_guard lock(countersMutex_);
+  counters_.sweeps = assembler_.stats();
+  counters_.unpaired = pairer_.unpaired();
+}
+
+void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFrame& frame) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<cv::Mat> bgr = fusion::decodeCameraFrame(frame);
+  if (!bgr) {
+    std::lock_guard lock(countersMutex_);
+    ++counters_.decodeErrors;
+    spdlog::warn("camera frame {}: {}", frame.sequence, bgr.error().message());
+    return;
+  }
+  FusedStack fused;
+  fused.stack = setup_.fuser->fuse(bgr.value(), sweep);
+  fused.stack.id = nextStackId_++;
+  fused.stack.stamp = frame.stamp;
+  fused.stack.source = "pipeline";
+  fused.sweepStart = sweep.start;
+  fused.sweepEnd = sweep.end;
+  fused.frameStamp = frame.stamp;
+  fused.fuseMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  {
+    std::lock_guard lock(countersMutex_);
+    ++counters_.stacksFused;
+    counters_.lastFuseMs = fused.fuseMs;
+  }
+  stackQueue_.push(std::move(fused));
+}
+
+void Pipeline::detectionLoop() {
+  const Eigen::Matrix3d K = setup_.fuser->projection().K;
+  const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;
+  while (!abandon_) {
+    detectionBeat_ = Stamp::now().ns;
+    auto fused = stackQueue_.pop(kIdleWake);
+    if (!fused) {
+      if (stackQueue_.closed()) break;
+      continue;
+    }
+    const auto detector = this->detector();
+    auto result = std::make_shared<StackResult>();
+    result->stackId = fused->stack.id;
+    result->sweepStart = fused->sweepStart;
+    result->sweepEnd = fused->sweepEnd;
+    result->frameStamp = fused->frameStamp;
+    result->sensorStamp = std::max(fused->sweepEnd, fused->frameStamp);
+    result->fuseMs = fused->fuseMs;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+      for (Detection& d : detector->detect(fused->stack)) {
+        LocatedDetection located;
+        located.position = localize(fused->stack, d.box, K, sweepToCamera);
+        if (located.position) d.position = std::array<double, 3>{located.position->robot.x(), located.position->robot.y(), located.position->robot.z()};
+        located.detection = std::move(d);
+        result->detections.push_back(std::move(located));
+      }
+    } catch (const std::exception& e) {
+      std::lock_guard lock(countersMutex_);
+      ++counters_.detectErrors;
+      spdlog::warn("detection on stack {}: {}", result->stackId, e.what());
+      continue;
+    }
+    result->detectMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    result->detectedAt = Stamp::now();
+    stackRate_.tick(result->detectedAt.ns);
+    {
+      std::lock_guard lock(countersMutex_);
+      ++counters_.stacksDetected;
+      counters_.detections += result->detections.size();
+      counters_.lastDetectMs = result->detectMs;
+    }
+    onResult_(std::move(result));
+  }
+  detectionDone_ = true;
+}
+
+PipelineCounters Pipeline::counters() const {
+  PipelineCounters c;
+  {
+    std::lock_guard lock(countersMutex_);
+    c = counters_;
+  }
+  c.sensorQueue = sensorQueue_.counters();
+  c.stackQueue = stackQueue_.counters();
+  const std::int64_t now = Stamp::now().ns;
+  c.scanRate = scanRate_.rate(now);
+  c.tiltRate = tiltRate_.rate(now);
+  c.frameRate = frameRate_.rate(now);
+  c.stackRate = stackRate_.rate(now);
+  return c;
+}
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,101 @@
+#include "fusedet/daemon/protocol.h"
+
+namespace fusedet::daemon {
+namespace {
+
+nlohmann::json vec3(const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+std::optional<Request> parseRequest(std::string_view line, std::string& error) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(line.begin(), line.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    error = std::string("not JSON: ") + e.what();
+    return std::nullopt;
+  }
+  if (!j.is_object()) {
+    error = "expected a JSON object";
+    return std::nullopt;
+  }
+  Request r;
+  if (j.contains("id")) r.id = j["id"];
+  const auto cmd = j.find("cmd");
+  if (cmd == j.end() || !cmd->is_string()) {
+    error = "missing \"cmd\" (a string: hello, subscribe, unsubscribe, latest, status)";
+    return std::nullopt;
+  }
+  const std::string c = cmd->get<std::string>();
+  if (c == "hello") r.command = Request::Command::kHello;
+  else if (c == "subscribe") r.command = Request::Command::kSubscribe;
+  else if (c == "unsubscribe") r.command = Request::Command::kUnsubscribe;
+  else if (c == "latest") r.command = Request::Command::kLatest;
+  else if (c == "status") r.command = Request::Command::kStatus;
+  else {
+    error = "unknown cmd '" + c.substr(0, 64) + "'";
+    return std::nullopt;
+  }
+  if (const auto classes = j.find("classes"); classes != j.end() && !classes->is_null()) {
+    if (r.command != Request::Command::kSubscribe) {
+      error = "\"classes\" only goes with subscribe";
+      return std::nullopt;
+    }
+    if (!classes->is_array()) {
+      error = "\"classes\" must be an array of class names";
+      return std::nullopt;
+    }
+    for (const auto& name : *classes) {
+      if (!name.is_string()) {
+        error = "\"classes\" must be an array of class names";
+        return std::nullopt;
+      }
+      r.classes.insert(name.get<std::string>());
+    }
+  }
+  return r;
+}
+
+nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& classes, const char* type) {
+  nlohmann::json dets = nlohmann::json::array();
+  for (const LocatedDetection& ld : r.detections) {
+    const Detection& d = ld.detection;
+    if (!classes.empty() && !classes.count(d.className)) continue;
+    nlohmann::json j;
+    j["class"] = d.className;
+    j["score"] = d.score;
+    j["box"] = {d.box.x, d.box.y, d.box.w, d.box.h};
+    if (ld.position) {
+      j["camera"] = vec3(ld.position->camera);
+      j["robot"] = vec3(ld.position->robot);
+      j["range"] = ld.position->range;
+    } else {
+      j["camera"] = nullptr;
+      j["robot"] = nullptr;
+      j["range"] = nullptr;
+    }
+    dets.push_back(std::move(j));
+  }
+  return {{"type", type},
+          {"stack", r.stackId},
+          {"sweep_start_ns", r.sweepStart.ns},
+          {"sweep_end_ns", r.sweepEnd.ns},
+          {"frame_ns", r.frameStamp.ns},
+          {"sensor_ns", r.sensorStamp.ns},
+          {"detected_ns", r.detectedAt.ns},
+          {"fuse_ms", r.fuseMs},
+          {"detect_ms", r.detectMs},
+          {"detections", std::move(dets)}};
+}
+
+std::string toLine(const nlohmann::json& message) {
+  return message.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+std::string errorLine(const std::string& reason, const nlohmann::json& id) {
+  nlohmann::json j{{"type", "error"}, {"error", reason}};
+  if (!id.is_null()) j["id"] = id;
+  return toLine(j);
+}
+
+}  // namespace fusedet::daemon

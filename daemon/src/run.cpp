@@ -1,0 +1,119 @@
+#include "fusedet/daemon/run.h"
+
+#include <poll.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
+#include <sys/signalfd.h>
+#include <systemd/sd-daemon.h>
+#include <unistd.h>
+
+#include <chrono>
+
+#include "fusedet/daemon/lms291_source.h"
+#include "fusedet/daemon/server.h"
+#include "fusedet/daemon/service.h"
+
+namespace fusedet::daemon {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr auto kShutdownBudget = std::chrono::milliseconds(1500);  // SIGTERM -> exit well under 2 s
+
+void notify(const std::string& state) { sd_notify(0, state.c_str()); }
+
+// The socket systemd passed (socket activation), or one bound at `path`.
+drivers::UniqueFd listenerFor(const std::string& path) {
+  const int n = sd_listen_fds(1);
+  if (n < 0) throw std::runtime_error(std::string("sd_listen_fds: ") + strerror(-n));
+  if (n > 1) throw std::runtime_error("socket activation passed " + std::to_string(n) + " sockets; expected 1");
+  if (n == 1) {
+    if (sd_is_socket_unix(SD_LISTEN_FDS_START, SOCK_STREAM, 1, nullptr, 0) <= 0)
+      throw std::runtime_error("socket activation: the passed fd is not a listening Unix stream socket");
+    spdlog::info("serving on the socket systemd passed");
+    return drivers::UniqueFd(SD_LISTEN_FDS_START);
+  }
+  auto fd = bindUnixSocket(path);
+  spdlog::info("serving on {}", path);
+  return fd;
+}
+
+ServiceParts liveParts(Config config, const std::filesystem::path& configFile, drivers::UniqueFd listener) {
+  if (!config.replay.file.empty())
+    throw std::runtime_error("replay.file is set, but this build has no sensor-log replay source");
+  ServiceParts parts;
+  parts.fuser = fuserFrom(config);
+  parts.detector = detectorFrom(config, configFile);
+  parts.sources.push_back(std::make_unique<Lms291Source>(config.laser));
+  parts.listener = std::move(listener);
+  parts.configFile = configFile;
+  parts.config = std::move(config);
+  parts.mode = "live";
+  return parts;
+}
+
+}  // namespace
+
+int runDaemon(const RunOptions& options) {
+  // Signals are taken from a signalfd; block them before any thread exists so none inherits them.
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  drivers::UniqueFd sigfd(signalfd(-1, &signals, SFD_CLOEXEC));
+
+  std::unique_ptr<Service> service;
+  try {
+    Config config = loadConfig(options.configFile);
+    if (!options.socketPath.empty()) config.socket.path = options.socketPath;
+    spdlog::set_level(spdlog::level::from_str(config.logLevel));
+    auto listener = listenerFor(config.socket.path);
+    service = std::make_unique<Service>(liveParts(std::move(config), options.configFile, std::move(listener)));
+    service->start();
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    notify(std::string("STATUS=failed: ") + e.what());
+    return 1;
+  }
+
+  std::uint64_t watchdogUs = 0;
+  if (sd_watchdog_enabled(0, &watchdogUs) <= 0) watchdogUs = 0;
+  // Ping at half the watchdog period; a thread whose beat is older than that is stalled.
+  const auto maxAgeNs = static_cast<std::int64_t>(watchdogUs ? watchdogUs * 500 : 5'000'000'000ULL);
+  const int tickMs = watchdogUs ? static_cast<int>(std::max<std::uint64_t>(50, std::min<std::uint64_t>(watchdogUs / 4000, 1000))) : 1000;
+  std::string shown = service->summary();
+  notify("READY=1\nSTATUS=" + shown);
+  spdlog::info("ready: {}", shown);
+
+  for (;;) {
+    pollfd pfd{sigfd.get(), POLLIN, 0};
+    const int n = ::poll(&pfd, 1, tickMs);
+    if (n > 0) {
+      signalfd_siginfo info{};
+      if (::read(sigfd.get(), &info, sizeof info) == static_cast<ssize_t>(sizeof info)) {
+        if (info.ssi_signo == SIGHUP) {
+          notify("RELOADING=1");
+          const std::string error = service->reload();
+          if (error.empty()) spdlog::info("reloaded {}", options.configFile.string());
+          else spdlog::error("reload failed, keeping the running configuration: {}", error);
+          shown = service->summary();
+          notify("READY=1\nSTATUS=" + shown);
+        } else {
+          spdlog::info("signal {}: draining and stopping", info.ssi_signo);
+          notify("STOPPING=1\nSTATUS=stopping");
+          service->stop(Clock::now() + kShutdownBudget);
+          return 0;
+        }
+      }
+    }
+    if (watchdogUs && service->alive(maxAgeNs)) notify("WATCHDOG=1");
+    if (std::string now = service->summary(); now != shown) {
+      shown = std::move(now);
+      notify("STATUS=" + shown);
+    }
+  }
+}
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,408 @@
+#include "fusedet/daemon/server.h"
+
+#include <fcntl.h>
+#include <spdlog/spdlog.h>
+#include <sys/epoll.h>
+#include <sys/eventfd.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <deque>
+#include <map>
+#include <set>
+#include <system_error>
+
+#include "fusedet/daemon/protocol.h"
+
+namespace fusedet::daemon {
+namespace {
+
+constexpr std::uint64_t kListenerKey = 0;
+constexpr std::uint64_t kWakeKey = 1;
+constexpr std::size_t kReadChunk = 16384;
+constexpr std::size_t kMaxReadPerWake = 262144;  // one busy client cannot monopolise the thread
+
+[[noreturn]] void throwErrno(const std::string& what) {
+  throw std::system_error(errno, std::generic_category(), what);
+}
+
+void setNonBlocking(int fd) {
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags < 0 || ::fcntl(fd, F_SETFL, flags | O_NONBLOCK) < 0) throwErrno("fcntl O_NONBLOCK");
+}
+
+}  // namespace
+
+struct Server::Client {
+  std::uint64_t key = 0;
+  drivers::UniqueFd fd;
+  std::string in;
+  bool discarding = false;  // skipping the rest of an oversized request line
+  bool readClosed = false;  // the client shut down its sending side
+  bool dead = false;
+  std::deque<std::shared_ptr<const std::string>> out;
+  std::size_t offset = 0;  // bytes of out.front() already sent
+  bool writeInterest = false;
+  bool subscribed = false;
+  std::set<std::string> classes;
+};
+
+drivers::UniqueFd bindUnixSocket(const std::string& path) {
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  if (path.empty() || path.size() >= sizeof addr.sun_path)
+    throw std::system_error(std::make_error_code(std::errc::filename_too_long), "socket path '" + path + "'");
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  drivers::UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+  if (!fd.valid()) throwErrno("socket");
+  auto* sa = reinterpret_cast<sockaddr*>(&addr);
+  if (::bind(fd.get(), sa, sizeof addr) < 0) {
+    if (errno != EADDRINUSE) throwErrno("bind " + path);
+    // A socket file exists: replace it only if nobody listens on it.
+    drivers::UniqueFd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+    if (::connect(probe.get(), sa, sizeof addr) == 0)
+      throw std::system_error(std::make_error_code(std::errc::address_in_use),
+                              path + ": another fusedetd is serving on it");
+    ::unlink(path.c_str());
+    if (::bind(fd.get(), sa, sizeof addr) < 0) throwErrno("bind " + path);
+  }
+  ::chmod(path.c_str(), 0660);
+  if (::listen(fd.get(), 64) < 0) throwErrno("listen " + path);
+  return fd;
+}
+
+Server::Server(drivers::UniqueFd listener, ServerLimits limits, Handlers handlers)
+    : listener_(std::move(listener)), handlers_(std::move(handlers)), limits_(limits) {
+  setNonBlocking(listener_.get());
+  epoll_.reset(::epoll_create1(EPOLL_CLOEXEC));
+  if (!epoll_.valid()) throwErrno("epoll_create1");
+  wake_.reset(::eventfd(0, EFD_CLOEXEC | EFD_NONBLOCK));
+  if (!wake_.valid()) throwErrno("eventfd");
+  epoll_event ev{};
+  ev.events = EPOLLIN;
+  ev.data.u64 = kListenerKey;
+  if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, listener_.get(), &ev) < 0) throwErrno("epoll_ctl listener");
+  ev.data.u64 = kWakeKey;
+  if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, wake_.get(), &ev) < 0) throwErrno("epoll_ctl eventfd");
+}
+
+Server::~Server() { stop(std::chrono::steady_clock::now()); }
+
+void Server::start() {
+  beat_ = Stamp::now().ns;
+  thread_ = std::thread([this] { run(); });
+}
+
+void Server::stop(std::chrono::steady_clock::time_point deadline) {
+  if (!thread_.joinable()) return;
+  deadline_ = deadline;
+  stopping_ = true;
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(wake_.get(), &one, sizeof one);
+  thread_.join();
+}
+
+void Server::publish(std::shared_ptr<const StackResult> result) {
+  {
+    std::lock_guard lock(mutex_);
+    latest_ = result;
+    // The server thread never blocks, so this only grows if it is starved of CPU; bound it anyway.
+    if (pending_.size() >= 1024) pending_.erase(pending_.begin());
+    pending_.push_back(std::move(result));
+  }
+  const std::uint64_t one = 1;
+  [[maybe_unused]] auto n = ::write(wake_.get(), &one, sizeof one);
+}
+
+void Server::setLimits(const ServerLimits& limits) {
+  std::lock_guard lock(mutex_);
+  limits_ = limits;
+}
+
+ServerCounters Server::counters() const {
+  std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+void Server::run() {
+  epoll_event events[64];
+  auto findClient = [this](std::uint64_t key) -> Client* {
+    for (auto& c : clients_)
+      if (c->key == key) return c.get();
+    return nullptr;
+  };
+  while (!stopping_) {
+    beat_ = Stamp::now().ns;
+    const int n = ::epoll_wait(epoll_.get(), events, 64, 200);
+    if (n < 0 && errno != EINTR) {
+      spdlog::error("server: epoll_wait: {}", std::strerror(errno));
+      break;
+    }
+    for (int i = 0; i < n; ++i) {
+      const std::uint64_t key = events[i].data.u64;
+      if (key == kWakeKey) {
+        std::uint64_t v;
+        [[maybe_unused]] auto r = ::read(wake_.get(), &v, sizeof v);
+      } else if (key == kListenerKey) {
+        accept();
+      } else if (Client* c = findClient(key); c && !c->dead) {
+        if (events[i].events & (EPOLLIN | EPOLLHUP | EPOLLERR)) readFrom(*c);
+        if (!c->dead && (events[i].events & EPOLLOUT)) flush(*c);
+      }
+    }
+    dispatch();
+    // Clients are destroyed only here, so no event of this batch can point at a reused fd.
+    std::erase_if(clients_, [](const std::unique_ptr<Client>& c) { return c->dead; });
+    std::lock_guard lock(mutex_);
+    counters_.clients = clients_.size();
+  }
+  // Shutdown: no new clients; send what is queued until the deadline.
+  ::epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, listener_.get(), nullptr);
+  dispatch();
+  while (std::chrono::steady_clock::now() < deadline_) {
+    bool pendingOutput = false;
+    for (auto& c : clients_)
+      if (!c->dead && !c->out.empty()) pendingOutput = true;
+    if (!pendingOutput) break;
+    const int n = ::epoll_wait(epoll_.get(), events, 64, 20);
+    for (int i = 0; i < n; ++i)
+      if (Client* c = findClient(events[i].data.u64); c && !c->dead && (events[i].events & EPOLLOUT)) flush(*c);
+  }
+  clients_.clear();
+  std::lock_guard lock(mutex_);
+  counters_.clients = 0;
+}
+
+void Server::accept() {
+  for (;;) {
+    drivers::UniqueFd fd(::accept4(listener_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
+    if (!fd.valid()) {
+      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR && errno != ECONNABORTED)
+        spdlog::warn("server: accept: {}", std::strerror(errno));
+      return;
+    }
+    ServerLimits limits;
+    {
+      std::lock_guard lock(mutex_);
+      limits = limits_;
+    }
+    if (clients_.size() >= static_cast<std::size_t>(limits.maxClients)) {
+      const std::string line = errorLine("too many clients (max_clients " + std::to_string(limits.maxClients) + ")");
+      [[maybe_unused]] auto w = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+      std::lock_guard lock(mutex_);
+      ++counters_.refused;
+      continue;
+    }
+    auto c = std::make_unique<Client>();
+    c->key = nextKey_++;
+    c->fd = std::move(fd);
+    epoll_event ev{};
+    ev.events = EPOLLIN | EPOLLRDHUP;
+    ev.data.u64 = c->key;
+    if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, c->fd.get(), &ev) < 0) {
+      spdlog::warn("server: epoll_ctl client: {}", std::strerror(errno));
+      continue;
+    }
+    clients_.push_back(std::move(c));
+    std::lock_guard lock(mutex_);
+    ++counters_.accepted;
+    counters_.clients = clients_.size();
+  }
+}
+
+void Server::readFrom(Client& c) {
+  std::size_t maxRequest;
+  {
+    std::lock_guard lock(mutex_);
+    maxRequest = limits_.maxRequestBytes;
+  }
+  char buf[kReadChunk];
+  std::size_t total = 0;
+  while (!c.dead && !c.readClosed && total < kMaxReadPerWake) {
+    const ssize_t n = ::recv(c.fd.get(), buf, sizeof buf, 0);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+      drop(c, false);
+      return;
+    }
+    if (n == 0) {
+      c.readClosed = true;  // half-close: replies already queued are still sent
+      break;
+    }
+    total += static_cast<std::size_t>(n);
+    std::string_view data(buf, static_cast<std::size_t>(n));
+    while (!data.empty() && !c.dead) {
+      const auto nl = data.find('\n');
+      const std::string_view part = data.substr(0, nl);
+      if (!c.discarding) c.in.append(part.substr(0, maxRequest + 1 - std::min(maxRequest + 1, c.in.size())));
+      if (!c.discarding && c.in.size() > maxRequest) {
+        // Over the limit: say so once and skip the rest of this line.
+        queue(c, std::make_shared<const std::string>(
+                     errorLine("request longer than " + std::to_string(maxRequest) + " bytes")));
+        {
+          std::lock_guard lock(mutex_);
+          ++counters_.oversized;
+        }
+        c.in.clear();
+        c.discarding = true;
+      }
+      if (nl == std::string_view::npos) break;
+      if (c.discarding) {
+        c.discarding = false;
+      } else {
+        std::string line = std::move(c.in);
+        c.in.clear();
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (!line.empty()) handleLine(c, line);
+      }
+      data.remove_prefix(nl + 1);
+    }
+  }
+  if (c.readClosed && !c.dead) {
+    if (c.out.empty()) {
+      drop(c, false);
+    } else {
+      epoll_event ev{};
+      ev.events = EPOLLOUT;
+      ev.data.u64 = c.key;
+      ::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, c.fd.get(), &ev);
+      c.writeInterest = true;
+    }
+  }
+}
+
+void Server::handleLine(Client& c, std::string_view line) {
+  std::string error;
+  const auto request = parseRequest(line, error);
+  if (!request) {
+    {
+      std::lock_guard lock(mutex_);
+      ++counters_.badRequests;
+    }
+    queue(c, std::make_shared<const std::string>(errorLine(error)));
+    return;
+  }
+  nlohmann::json reply;
+  switch (request->command) {
+    case Request::Command::kHello:
+      reply = handlers_.hello ? handlers_.hello() : nlohmann::json::object();
+      reply["type"] = "hello";
+      break;
+    case Request::Command::kSubscribe:
+      c.subscribed = true;
+      c.classes = request->classes;
+      reply = {{"type", "subscribed"}, {"classes", c.classes}};
+      break;
+    case Request::Command::kUnsubscribe:
+      c.subscribed = false;
+      reply = {{"type", "unsubscribed"}};
+      break;
+    case Request::Command::kLatest: {
+      std::shared_ptr<const StackResult> latest;
+      {
+        std::lock_guard lock(mutex_);
+        latest = latest_;
+      }
+      if (latest) {
+        reply = resultToJson(*latest, {}, "latest");
+      } else {
+        reply = {{"type", "latest"}, {"stack", nullptr}, {"detections", nlohmann::json::array()}};
+      }
+      break;
+    }
+    case Request::Command::kStatus:
+      reply = handlers_.status ? handlers_.status() : nlohmann::json::object();
+      reply["type"] = "status";
+      break;
+  }
+  if (!request->id.is_null()) reply["id"] = request->id;
+  queue(c, std::make_shared<const std::string>(toLine(reply)));
+}
+
+void Server::queue(Client& c, std::shared_ptr<const std::string> line) {
+  if (c.dead) return;
+  std::size_t limit;
+  {
+    std::lock_guard lock(mutex_);
+    limit = limits_.clientQueue;
+    ++counters_.linesSent;
+  }
+  if (c.out.size() >= limit) {
+    // The client does not keep up (or does not read at all): it goes, nobody waits for it.
+    drop(c, true);
+    return;
+  }
+  c.out.push_back(std::move(line));
+  if (!c.writeInterest) flush(c);
+}
+
+void Server::flush(Client& c) {
+  while (!c.out.empty()) {
+    const std::string& s = *c.out.front();
+    const ssize_t n = ::send(c.fd.get(), s.data() + c.offset, s.size() - c.offset, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      if (errno == EAGAIN || errno == EWOULDBLOCK) break;
+      drop(c, false);
+      return;
+    }
+    c.offset += static_cast<std::size_t>(n);
+    if (c.offset == s.size()) {
+      c.out.pop_front();
+      c.offset = 0;
+    }
+  }
+  if (c.out.empty() && c.readClosed) {
+    drop(c, false);
+    return;
+  }
+  updateInterest(c);
+}
+
+void Server::updateInterest(Client& c) {
+  const bool want = !c.out.empty();
+  if (want == c.writeInterest) return;
+  epoll_event ev{};
+  ev.events = (c.readClosed ? 0u : static_cast<unsigned>(EPOLLIN | EPOLLRDHUP)) | (want ? static_cast<unsigned>(EPOLLOUT) : 0u);
+  ev.data.u64 = c.key;
+  ::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, c.fd.get(), &ev);
+  c.writeInterest = want;
+}
+
+void Server::drop(Client& c, bool slow) {
+  if (c.dead) return;
+  c.dead = true;
+  ::epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, c.fd.get(), nullptr);
+  c.fd.reset();
+  c.out.clear();
+  std::lock_guard lock(mutex_);
+  if (slow) ++counters_.droppedSlow;
+  else ++counters_.disconnected;
+}
+
+void Server::dispatch() {
+  std::vector<std::shared_ptr<const StackResult>> results;
+  {
+    std::lock_guard lock(mutex_);
+    results.swap(pending_);
+    counters_.results += results.size();
+  }
+  for (const auto& r : results) {
+    // One encoded line per distinct class filter, shared by the clients using it.
+    std::map<std::set<std::string>, std::shared_ptr<const std::string>> lines;
+    for (auto& c : clients_) {
+      if (c->dead || !c->subscribed) continue;
+      auto& line = lines[c->classes];
+      if (!line) line = std::make_shared<const std::string>(toLine(resultToJson(*r, c->classes)));
+      queue(*c, line);
+    }
+    latency_.add(static_cast<double>(Stamp::now() - r->sensorStamp) * 1e-6);
+  }
+}
+
+}  // namespace fusedet::daemon

@@ -1,0 +1,199 @@
+#include "fusedet/daemon/service.h"
+
+#include <spdlog/spdlog.h>
+
+#include <sstream>
+
+#include "fusedet/daemon/protocol.h"
+#include "fusedet/fusion/camera_model.h"
+
+namespace fusedet::daemon {
+
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config) {
+  const fusion::CameraModel camera = fusion::readCameraModel(config.camera.calibration);
+  fusion::ProjectionConfig projection;
+  projection.laserLayerScale = config.fusion.laserLayerScale;
+  projection.holeFillRadius = config.fusion.holeFillRadius;
+  return std::make_shared<const fusion::Fuser>(
+      camera, fusion::rigidFromRpyDeg(config.fusion.rotationRpyDeg, config.fusion.translation), projection);
+}
+
+fusion::SweepConfig sweepConfigFrom(const Config& config) {
+  fusion::SweepConfig s;
+  s.tiltAxisOffset = Eigen::Vector3d(config.fusion.tiltAxisOffset[0], config.fusion.tiltAxisOffset[1],
+                                     config.fusion.tiltAxisOffset[2]);
+  s.tiltWindowS = config.fusion.tiltWindowMs * 1e-3;
+  return s;
+}
+
+ServerLimits serverLimitsFrom(const Config& config) {
+  ServerLimits l;
+  l.maxClients = config.socket.maxClients;
+  l.maxRequestBytes = static_cast<std::size_t>(config.socket.maxRequestBytes);
+  l.clientQueue = static_cast<std::size_t>(config.socket.clientQueue);
+  return l;
+}
+
+std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile) {
+  return std::make_shared<const CascadeSet>(config.detection, configFile.parent_path());
+}
+
+Service::Service(ServiceParts parts)
+    : config_(std::move(parts.config)),
+      configFile_(std::move(parts.configFile)),
+      mode_(std::move(parts.mode)),
+      sources_(std::move(parts.sources)) {
+  Server::Handlers handlers{[this] { return hello(); }, [this] { return status(); }};
+  server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
+  PipelineSetup setup;
+  setup.fuser = std::move(parts.fuser);
+  setup.sweep = sweepConfigFrom(config_);
+  setup.maxPairSkewNs = std::int64_t{config_.fusion.maxPairSkewMs} * 1'000'000;
+  pipeline_ = std::make_unique<Pipeline>(std::move(setup), std::move(parts.detector),
+                                         [this](std::shared_ptr<const StackResult> r) { server_->publish(std::move(r)); });
+}
+
+Service::~Service() { stop(std::chrono::steady_clock::now()); }
+
+void Service::start() {
+  startedNs_ = Stamp::now().ns;
+  server_->start();
+  pipeline_->start();
+  for (auto& s : sources_) s->start(*pipeline_);
+  started_ = true;
+}
+
+void Service::stop(std::chrono::steady_clock::time_point deadline) {
+  if (!started_) return;
+  started_ = false;
+  for (auto& s : sources_) s->stop();
+  pipeline_->stop(deadline);
+  server_->stop(deadline);
+}
+
+Config Service::config() const {
+  std::lock_guard lock(mutex_);
+  return config_;
+}
+
+std::string Service::reload() {
+  if (configFile_.empty()) return "no config file to reload";
+  Config next;
+  try {
+    next = loadConfig(configFile_);
+  } catch (const ConfigError& e) {
+    std::lock_guard lock(mutex_);
+    lastReloadError_ = e.what();
+    return lastReloadError_;
+  }
+  return reload(next);
+}
+
+std::string Service::reload(const Config& next) {
+  std::shared_ptr<const StackDetector> detector;
+  try {
+    detector = detectorFrom(next, configFile_);
+  } catch (const std::exception& e) {
+    std::lock_guard lock(mutex_);
+    lastReloadError_ = e.what();
+    return lastReloadError_;
+  }
+  pipeline_->setDetector(std::move(detector));
+  server_->setLimits(serverLimitsFrom(next));
+  spdlog::set_level(spdlog::level::from_str(next.logLevel));
+  std::lock_guard lock(mutex_);
+  // What else changed needs a restart (devices, socket path, fusion geometry).
+  Config applied = config_;
+  applied.detection = next.detection;
+  applied.logLevel = next.logLevel;
+  applied.socket.maxClients = next.socket.maxClients;
+  applied.socket.maxRequestBytes = next.socket.maxRequestBytes;
+  applied.socket.clientQueue = next.socket.clientQueue;
+  if (dumpConfig(applied) != dumpConfig(next))
+    spdlog::warn("reload: changes outside detection, socket limits and log level take effect after a restart");
+  config_ = applied;
+  lastReloadError_.clear();
+  ++reloads_;
+  return "";
+}
+
+nlohmann::json Service::hello() const {
+  return {{"protocol", kProtocolVersion},
+          {"version", FUSEDET_DAEMON_VERSION},
+          {"mode", mode_},
+          {"classes", pipeline_->detector()->classes()}};
+}
+
+nlohmann::json Service::status() const {
+  const std::int64_t now = Stamp::now().ns;
+  const PipelineCounters p = pipeline_->counters();
+  const ServerCounters s = server_->counters();
+  const LatencySummary lat = server_->latency();
+  nlohmann::json sensors = nlohmann::json::array();
+  for (const auto& src : sources_)
+    for (const SensorHealth& h : src->health())
+      sensors.push_back({{"name", h.name},
+                         {"state", h.state},
+                         {"messages", h.messages},
+                         {"crc_errors", h.crcErrors},
+                         {"reconnects", h.reconnects},
+                         {"lost", h.lost},
+                         {"last_error", h.lastError}});
+  std::lock_guard lock(mutex_);
+  return {
+      {"mode", mode_},
+      {"uptime_s", static_cast<double>(now - startedNs_) * 1e-9},
+      {"classes", pipeline_->detector()->classes()},
+      {"sensors", std::move(sensors)},
+      {"rates_hz", {{"scans", p.scanRate}, {"tilt", p.tiltRate}, {"frames", p.frameRate}, {"stacks", p.stackRate}}},
+      {"pipeline",
+       {{"sensor_queue", {{"depth", p.sensorQueue.depth}, {"pushed", p.sensorQueue.pushed}, {"dropped", p.sensorQueue.dropped}}},
+        {"stack_queue", {{"depth", p.stackQueue.depth}, {"pushed", p.stackQueue.pushed}, {"dropped", p.stackQueue.dropped}}},
+        {"sweeps", p.sweeps.sweeps},
+        {"scans_dropped_no_tilt", p.sweeps.scansDroppedNoTilt},
+        {"unpaired_sweeps", p.unpaired},
+        {"decode_errors", p.decodeErrors},
+        {"fuse_errors", p.fuseErrors},
+        {"detect_errors", p.detectErrors},
+        {"stacks_fused", p.stacksFused},
+        {"stacks_detected", p.stacksDetected},
+        {"detections", p.detections},
+        {"last_fuse_ms", p.lastFuseMs},
+        {"last_detect_ms", p.lastDetectMs}}},
+      {"latency_ms", {{"samples", lat.samples}, {"p50", lat.p50Ms}, {"p90", lat.p90Ms}, {"p99", lat.p99Ms}, {"max", lat.maxMs}}},
+      {"clients",
+       {{"connected", s.clients},
+        {"accepted", s.accepted},
+        {"refused", s.refused},
+        {"dropped_slow", s.droppedSlow},
+        {"disconnected", s.disconnected},
+        {"bad_requests", s.badRequests},
+        {"oversized_requests", s.oversized}}},
+      {"reloads", reloads_},
+      {"last_reload_error", lastReloadError_}};
+}
+
+bool Service::alive(std::int64_t maxAgeNs) const {
+  const std::int64_t now = Stamp::now().ns;
+  return now - pipeline_->fusionBeatNs() < maxAgeNs && now - pipeline_->detectionBeatNs() < maxAgeNs &&
+         now - server_->beatNs() < maxAgeNs;
+}
+
+std::string Service::summary() const {
+  const PipelineCounters p = pipeline_->counters();
+  const ServerCounters s = server_->counters();
+  std::ostringstream o;
+  o << mode_ << ": ";
+  bool first = true;
+  for (const auto& src : sources_)
+    for (const SensorHealth& h : src->health()) {
+      o << (first ? "" : ", ") << h.name << ' ' << h.state;
+      first = false;
+    }
+  o << "; " << p.stacksDetected << " stacks, " << p.stackQueue.dropped << " dropped; " << s.clients << " clients";
+  std::lock_guard lock(mutex_);
+  if (!lastReloadError_.empty()) o << "; reload failed: " << lastReloadError_;
+  return o.str();
+}
+
+}  // namespace fusedet::daemon

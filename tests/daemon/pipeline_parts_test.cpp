@@ -1,0 +1,162 @@
+// Unit tests of the daemon's small parts: the drop-oldest queue, the meters, the request parser
+// (with garbage input) and 3D localization from the distance layer.
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "fusedet/daemon/bounded_queue.h"
+#include "fusedet/daemon/localize.h"
+#include "fusedet/daemon/protocol.h"
+#include "fusedet/daemon/stack_detector.h"
+#include "fusedet/daemon/stats.h"
+#include "fusedet/fusion/projection.h"
+
+using namespace fusedet;
+using namespace fusedet::daemon;
+
+TEST(BoundedQueue, DropsTheOldestAndCountsIt) {
+  BoundedQueue<int> q(3);
+  for (int i = 0; i < 5; ++i) q.push(i);
+  const auto c = q.counters();
+  EXPECT_EQ(c.pushed, 5u);
+  EXPECT_EQ(c.dropped, 2u);
+  EXPECT_EQ(c.depth, 3u);
+  EXPECT_EQ(q.pop(std::chrono::milliseconds(0)), 2);  // 0 and 1 were dropped
+  q.close();
+  EXPECT_FALSE(q.push(9));
+  EXPECT_EQ(q.pop(std::chrono::milliseconds(0)), 3);
+  EXPECT_EQ(q.pop(std::chrono::milliseconds(0)), 4);
+  EXPECT_EQ(q.pop(std::chrono::milliseconds(50)), std::nullopt);
+}
+
+TEST(Stats, PercentilesAndRates) {
+  std::vector<double> v;
+  for (int i = 100; i >= 1; --i) v.push_back(i);
+  EXPECT_DOUBLE_EQ(percentile(v, 0.5), 50);
+  EXPECT_DOUBLE_EQ(percentile(v, 0.99), 99);
+  EXPECT_DOUBLE_EQ(percentile(v, 1.0), 100);
+  LatencyRecorder r(10);
+  for (int i = 1; i <= 20; ++i) r.add(i);  // keeps 11..20
+  EXPECT_EQ(r.summary().samples, 10u);
+  EXPECT_DOUBLE_EQ(r.summary().p50Ms, 15);
+  EXPECT_DOUBLE_EQ(r.summary().maxMs, 20);
+  RateMeter m(1'000'000'000);
+  for (int i = 0; i < 10; ++i) m.tick(i * 100'000'000LL);  // 10 Hz
+  EXPECT_NEAR(m.rate(950'000'000LL), 10.0, 1e-9);
+  EXPECT_NEAR(m.rate(5'000'000'000LL), 0.0, 1e-9);
+  EXPECT_EQ(m.total(), 10u);
+}
+
+TEST(Protocol, ParsesTheDocumentedRequests) {
+  std::string err;
+  auto r = parseRequest(R"({"cmd":"subscribe","classes":["car","bike"],"id":7})", err);
+  ASSERT_TRUE(r) << err;
+  EXPECT_EQ(r->command, Request::Command::kSubscribe);
+  EXPECT_EQ(r->classes, (std::set<std::string>{"bike", "car"}));
+  EXPECT_EQ(r->id, 7);
+  EXPECT_TRUE(parseRequest(R"({"cmd":"status"})", err));
+  EXPECT_FALSE(parseRequest(R"({"cmd":"launch"})", err));
+  EXPECT_EQ(err, "unknown cmd 'launch'");
+  EXPECT_FALSE(parseRequest(R"({"cmd":"status","classes":["car"]})", err));
+  EXPECT_FALSE(parseRequest(R"({"cmd":"subscribe","classes":"car"})", err));
+  EXPECT_FALSE(parseRequest(R"([1,2])", err));
+  EXPECT_EQ(err, "expected a JSON object");
+  EXPECT_FALSE(parseRequest("{\"cmd\":", err));
+  EXPECT_EQ(err.rfind("not JSON", 0), 0u);
+}
+
+TEST(Protocol, GarbageNeverThrowsAndAlwaysSaysWhy) {
+  std::mt19937 rng(13);
+  const std::string seed = R"({"cmd":"subscribe","classes":["car"],"id":"x"})";
+  for (int i = 0; i < 20000; ++i) {
+    std::string s = seed;
+    const int edits = 1 + static_cast<int>(rng() % 6);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = rng() % (s.size() + 1);
+      switch (rng() % 3) {
+        case 0: if (at < s.size()) s.erase(at, 1); break;
+        case 1: s.insert(s.begin() + static_cast<std::ptrdiff_t>(at), static_cast<char>(rng() % 256)); break;
+        default: if (at < s.size()) s[at] = static_cast<char>(rng() % 256);
+      }
+    }
+    std::string err;
+    std::optional<Request> r;
+    ASSERT_NO_THROW(r = parseRequest(s, err)) << s;
+    if (!r) {
+      EXPECT_FALSE(err.empty()) << s;
+    }
+  }
+}
+
+TEST(Protocol, ResultLineFiltersClassesAndCarriesStampsAndPositions) {
+  StackResult r;
+  r.stackId = 4;
+  r.sweepStart = Stamp{100};
+  r.sweepEnd = Stamp{200};
+  r.frameStamp = Stamp{150};
+  r.sensorStamp = Stamp{200};
+  LocatedDetection car, bike;
+  car.detection.className = "car";
+  car.detection.box = {1, 2, 3, 4};
+  Position p;
+  p.camera = {1, 2, 3};
+  p.robot = {3, -1, -2};
+  p.range = 3.74;
+  car.position = p;
+  bike.detection.className = "bike";
+  r.detections = {car, bike};
+  const auto all = resultToJson(r);
+  EXPECT_EQ(all["detections"].size(), 2u);
+  EXPECT_EQ(all["frame_ns"], 150);
+  EXPECT_EQ(all["sweep_start_ns"], 100);
+  const auto onlyBike = resultToJson(r, {"bike"});
+  ASSERT_EQ(onlyBike["detections"].size(), 1u);
+  EXPECT_TRUE(onlyBike["detections"][0]["camera"].is_null());
+  const auto c = all["detections"][0];
+  EXPECT_EQ(c["box"], nlohmann::json({1, 2, 3, 4}));
+  EXPECT_EQ(c["robot"], nlohmann::json({3, -1, -2}));
+  EXPECT_EQ(errorLine("x", 5), "{\"error\":\"x\",\"id\":5,\"type\":\"error\"}\n");
+}
+
+TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
+  const Config::Detection d;
+  const boosting::ScanParams s = scanParamsFrom(d), lib;
+  EXPECT_EQ(s.step, lib.step);
+  EXPECT_EQ(s.scaleFactor, lib.scaleFactor);
+  EXPECT_EQ(s.minWidth, lib.minWidth);
+  EXPECT_EQ(s.maxWidth, lib.maxWidth);
+  const boosting::GroupParams g = groupParamsFrom(d), glib;
+  EXPECT_EQ(g.method, glib.method);
+  EXPECT_EQ(g.minNeighbors, glib.minNeighbors);
+  EXPECT_EQ(g.iouThreshold, glib.iouThreshold);
+}
+
+// A 200 x 100 image, laser layers at half size: background at 20 m, an object at 5 m covering
+// the box, a few filled cells at 1 m that must not count.
+TEST(Localize, NearSurfaceInsideTheBoxOnTheCentreRay) {
+  LayerStack stack(200, 100);
+  cv::Mat dist(50, 100, CV_32F, cv::Scalar(20.0f)), mask(50, 100, CV_8U, cv::Scalar(fusion::kMaskMeasured));
+  dist(cv::Rect(40, 10, 20, 30)).setTo(5.0f);
+  dist(cv::Rect(48, 24, 3, 3)).setTo(1.0f);
+  mask(cv::Rect(48, 24, 3, 3)).setTo(fusion::kMaskFilled);
+  stack.set(Layer{"distance", dist, mask});
+  Eigen::Matrix3d K;
+  K << 100, 0, 100, 0, 100, 50, 0, 0, 1;
+  // Box (reference px) = laser cells [35, 65) x [5, 45) doubled: the object plus background.
+  const Box box{70, 10, 60, 80};
+  Eigen::Isometry3d sweepToCamera = Eigen::Isometry3d::Identity();
+  sweepToCamera.translation() = Eigen::Vector3d(0, 0, -1);
+  const auto p = localize(stack, box, K, sweepToCamera);
+  ASSERT_TRUE(p);
+  EXPECT_FLOAT_EQ(static_cast<float>(p->range), 5.0f);
+  // Centre pixel (100, 50) is the principal point: straight ahead.
+  EXPECT_NEAR(p->camera.x(), 0, 1e-9);
+  EXPECT_NEAR(p->camera.z(), 5, 1e-9);
+  EXPECT_NEAR(p->robot.z(), 6, 1e-9);  // robot = camera - translation
+  // No measured cells: no position.
+  LayerStack empty(200, 100);
+  empty.set(Layer{"distance", cv::Mat(50, 100, CV_32F, cv::Scalar(0.0f)), cv::Mat(50, 100, CV_8U, cv::Scalar(0))});
+  EXPECT_FALSE(localize(empty, box, K, sweepToCamera));
+  EXPECT_FALSE(localize(LayerStack(200, 100), box, K, sweepToCamera));
+}

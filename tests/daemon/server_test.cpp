@@ -1,0 +1,224 @@
+// The socket server under hostile and mixed clients, fed with synthetic stack results at a steady
+// rate (no detection cost, so the test is about the server): 50 clients at once - normal,
+// class-filtered, slow, silent, malformed, oversized and flapping. Clients that keep up must get
+// every result in order; the others are dropped or answered with error lines, never stalling
+// anyone.
+
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <thread>
+
+#include "fusedet/daemon/client.h"
+#include "fusedet/daemon/protocol.h"
+#include "fusedet/daemon/server.h"
+
+using namespace fusedet;
+using namespace fusedet::daemon;
+using namespace std::chrono_literals;
+
+namespace {
+
+std::string tempSocket(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("fusedet-test-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+std::shared_ptr<const StackResult> makeResult(std::uint64_t id) {
+  auto r = std::make_shared<StackResult>();
+  r->stackId = id;
+  r->sensorStamp = Stamp::now();
+  r->frameStamp = r->sensorStamp;
+  for (int i = 0; i < 10; ++i) {  // ~1.5 kB per line
+    LocatedDetection d;
+    d.detection.className = i % 2 ? "car" : "bike";
+    d.detection.score = i;
+    d.detection.box = {double(i), 2, 30, 40};
+    r->detections.push_back(d);
+  }
+  return r;
+}
+
+struct Received {
+  std::vector<std::uint64_t> ids;
+  bool closed = false;
+  bool classesOk = true;
+};
+
+// Subscribes and reads until `count` results arrived or the server closed the connection.
+Received follow(const std::string& path, std::size_t count, std::chrono::milliseconds pause,
+                const std::vector<std::string>& classes = {}) {
+  Received got;
+  Client c(path);
+  nlohmann::json req{{"cmd", "subscribe"}};
+  if (!classes.empty()) req["classes"] = classes;
+  c.send(req);
+  auto reply = c.read(10s);
+  if (!reply || (*reply)["type"] != "subscribed") return got;
+  while (got.ids.size() < count) {
+    auto m = c.read(15s);
+    if (!m) {
+      got.closed = c.closed();
+      return got;
+    }
+    if ((*m)["type"] != "detections") continue;
+    got.ids.push_back((*m)["stack"].get<std::uint64_t>());
+    for (const auto& d : (*m)["detections"])
+      if (!classes.empty() && std::find(classes.begin(), classes.end(), d["class"]) == classes.end())
+        got.classesOk = false;
+    if (pause.count()) std::this_thread::sleep_for(pause);
+  }
+  return got;
+}
+
+}  // namespace
+
+TEST(Server, FiftyMixedClientsNoneStallsAndKeepersGetEverything) {
+  const std::string path = tempSocket("mixed.sock");
+  ServerLimits limits;
+  limits.maxClients = 64;
+  limits.clientQueue = 1024;
+  limits.maxRequestBytes = 1024;
+  Server server(bindUnixSocket(path), limits, {[] { return nlohmann::json{{"classes", {"car", "bike"}}}; },
+                                                [] { return nlohmann::json{{"ok", true}}; }});
+  server.start();
+  constexpr std::size_t kResults = 2000;
+
+  std::vector<std::thread> threads;
+  std::vector<Received> normal(20), filtered(5), slow(5);
+  std::atomic<int> malformedOk{0}, oversizedOk{0}, flaps{0};
+  std::atomic<bool> publishing{true};
+  for (auto& r : normal) threads.emplace_back([&, p = &r] { *p = follow(path, kResults, 0ms); });
+  for (auto& r : filtered) threads.emplace_back([&, p = &r] { *p = follow(path, kResults, 0ms, {"car"}); });
+  for (auto& r : slow) threads.emplace_back([&, p = &r] { *p = follow(path, kResults, 50ms); });
+  // Silent: subscribe and never read.
+  std::vector<std::unique_ptr<Client>> silent;
+  for (int i = 0; i < 5; ++i) {
+    silent.push_back(std::make_unique<Client>(path));
+    silent.back()->send({{"cmd", "subscribe"}});
+  }
+  // Malformed and oversized: an error line each, then the connection still answers.
+  for (int i = 0; i < 5; ++i)
+    threads.emplace_back([&, i] {
+      Client c(path);
+      if (i % 2) {
+        c.sendLine("{\"cmd\": \"subscribe\", \"classes\": [tru");
+        c.sendLine("\x01\x02\xff garbage");
+        auto e1 = c.read(10s), e2 = c.read(10s);
+        if (e1 && e2 && (*e1)["type"] == "error" && (*e2)["type"] == "error") {
+          c.send({{"cmd", "hello"}});
+          auto h = c.read(10s);
+          if (h && (*h)["type"] == "hello") ++malformedOk;
+        }
+      } else {
+        c.sendLine(std::string(100000, 'x'));
+        auto e = c.read(10s);
+        if (e && (*e)["type"] == "error" && (*e)["error"].get<std::string>().find("longer than 1024") != std::string::npos) {
+          c.send({{"cmd", "status"}});
+          auto s = c.read(10s);
+          if (s && (*s)["type"] == "status") ++oversizedOk;
+        }
+      }
+    });
+  // Flapping: connect, subscribe, maybe read a little, vanish - again and again.
+  for (int i = 0; i < 10; ++i)
+    threads.emplace_back([&, i] {
+      while (publishing) {
+        try {
+          Client c(path);
+          c.send({{"cmd", "subscribe"}});
+          if (i % 2) (void)c.read(20ms);
+          ++flaps;
+          std::this_thread::sleep_for(5ms);
+        } catch (const std::exception&) {
+          // refused while at the client limit: fine, try again
+        }
+      }
+    });
+
+  std::this_thread::sleep_for(300ms);  // let everyone subscribe
+  const auto t0 = std::chrono::steady_clock::now();
+  for (std::size_t i = 0; i < kResults; ++i) {
+    server.publish(makeResult(i));
+    std::this_thread::sleep_until(t0 + (i + 1) * 2500us);  // 400 stacks/s
+  }
+  const double publishS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  publishing = false;
+  for (auto& t : threads) t.join();
+
+  // publish() never waited on anyone: 2000 results at 400/s took about 5 s.
+  EXPECT_LT(publishS, 8.0);
+  std::vector<std::uint64_t> all(kResults);
+  for (std::size_t i = 0; i < kResults; ++i) all[i] = i;
+  for (const auto& r : normal) EXPECT_EQ(r.ids, all);
+  for (const auto& r : filtered) {
+    EXPECT_EQ(r.ids, all);
+    EXPECT_TRUE(r.classesOk);
+  }
+  for (const auto& r : slow) {
+    EXPECT_TRUE(r.closed) << "a slow client was not dropped";
+    EXPECT_LT(r.ids.size(), kResults);
+  }
+  EXPECT_EQ(malformedOk, 2);  // clients 1 and 3
+  EXPECT_EQ(oversizedOk, 3);  // clients 0, 2 and 4
+  EXPECT_GT(flaps, 50);
+  const ServerCounters c = server.counters();
+  EXPECT_GE(c.droppedSlow, 10u);  // 5 slow + 5 silent
+  EXPECT_EQ(c.badRequests, 4u);
+  EXPECT_EQ(c.oversized, 3u);
+  EXPECT_EQ(c.results, kResults);
+  // The silent clients are gone: their socket reads EOF after the buffered lines.
+  for (auto& s : silent) {
+    while (s->readLine(2s)) {
+    }
+    EXPECT_TRUE(s->closed());
+  }
+  server.stop(std::chrono::steady_clock::now() + 1s);
+}
+
+TEST(Server, ClientLimitLatestAndHalfClose) {
+  const std::string path = tempSocket("limit.sock");
+  ServerLimits limits;
+  limits.maxClients = 2;
+  Server server(bindUnixSocket(path), limits, {});
+  server.start();
+  Client a(path), b(path);
+  a.send({{"cmd", "latest"}, {"id", "q1"}});
+  auto none = a.read(5s);
+  ASSERT_TRUE(none);
+  EXPECT_EQ((*none)["type"], "latest");
+  EXPECT_TRUE((*none)["stack"].is_null());
+  EXPECT_EQ((*none)["id"], "q1");
+  b.send({{"cmd", "hello"}});
+  ASSERT_TRUE(b.read(5s));  // b is registered
+  Client c(path);
+  auto refused = c.read(5s);
+  ASSERT_TRUE(refused);
+  EXPECT_EQ((*refused)["type"], "error");
+  EXPECT_NE((*refused)["error"].get<std::string>().find("too many clients"), std::string::npos);
+  EXPECT_FALSE(c.read(2s));
+  EXPECT_TRUE(c.closed());
+  server.publish(makeResult(41));
+  // `latest` answers with the newest result even to a client that never subscribed.
+  std::this_thread::sleep_for(100ms);
+  a.send({{"cmd", "latest"}});
+  auto latest = a.read(5s);
+  ASSERT_TRUE(latest);
+  EXPECT_EQ((*latest)["stack"], 41);
+  EXPECT_EQ((*latest)["detections"].size(), 10u);
+  // A client that sends its request and shuts down its side still gets the reply, then EOF.
+  b.send({{"cmd", "status"}});
+  ::shutdown(b.fd(), SHUT_WR);
+  auto status = b.read(5s);
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["type"], "status");
+  EXPECT_FALSE(b.read(2s));
+  EXPECT_TRUE(b.closed());
+  // A live socket path is not stolen by a second server.
+  EXPECT_THROW(bindUnixSocket(path), std::system_error);
+  server.stop(std::chrono::steady_clock::now() + 1s);
+}
