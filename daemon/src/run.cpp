@@ -2,6 +2,7 @@
 
 #include <poll.h>
 #include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <sys/signalfd.h>
 #include <systemd/sd-daemon.h>
@@ -37,14 +38,13 @@ drivers::UniqueFd listenerFor(const std::string& path) {
   return fd;
 }
 
-ServiceParts liveParts(Config config, const std::filesystem::path& configFile, drivers::UniqueFd listener) {
+ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
   if (!config.replay.file.empty())
     throw std::runtime_error("replay.file is set, but this build has no sensor-log replay source");
   ServiceParts parts;
-  parts.fuser = fuserFrom(config);
+  parts.fuser = fuserFrom(config, configFile);
   parts.detector = detectorFrom(config, configFile);
   parts.sources.push_back(std::make_unique<Lms291Source>(config.laser));
-  parts.listener = std::move(listener);
   parts.configFile = configFile;
   parts.config = std::move(config);
   parts.mode = "live";
@@ -63,14 +63,19 @@ int runDaemon(const RunOptions& options) {
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
   drivers::UniqueFd sigfd(signalfd(-1, &signals, SFD_CLOEXEC));
+  // Log lines go to stderr (the journal under systemd); stdout stays free.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("fusedetd"));
+  spdlog::set_pattern("%^%l%$: %v");
 
   std::unique_ptr<Service> service;
   try {
     Config config = loadConfig(options.configFile);
     if (!options.socketPath.empty()) config.socket.path = options.socketPath;
     spdlog::set_level(spdlog::level::from_str(config.logLevel));
-    auto listener = listenerFor(config.socket.path);
-    service = std::make_unique<Service>(liveParts(std::move(config), options.configFile, std::move(listener)));
+    const std::string socketPath = config.socket.path;
+    ServiceParts parts = liveParts(std::move(config), options.configFile);
+    parts.listener = listenerFor(socketPath);  // last: nothing is bound when the set-up fails
+    service = std::make_unique<Service>(std::move(parts));
     service->start();
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

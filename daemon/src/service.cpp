@@ -9,8 +9,10 @@
 
 namespace fusedet::daemon {
 
-std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config) {
-  const fusion::CameraModel camera = fusion::readCameraModel(config.camera.calibration);
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile) {
+  std::filesystem::path calibration = config.camera.calibration;
+  if (calibration.is_relative()) calibration = configFile.parent_path() / calibration;
+  const fusion::CameraModel camera = fusion::readCameraModel(calibration);
   fusion::ProjectionConfig projection;
   projection.laserLayerScale = config.fusion.laserLayerScale;
   projection.holeFillRadius = config.fusion.holeFillRadius;

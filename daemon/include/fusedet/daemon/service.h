@@ -30,9 +30,10 @@ struct ServiceParts {
   std::string mode = "live";   // "live" | "replay" | "scenes"
 };
 
-// Fusion settings (camera calibration file, extrinsics, laser layers) of a config. Throws
-// std::runtime_error naming the calibration file on failure.
-std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config);
+// Fusion settings (camera calibration file, extrinsics, laser layers) of a config; a relative
+// calibration path is relative to the config file's folder. Throws std::runtime_error naming the
+// calibration file on failure.
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile);
 fusion::SweepConfig sweepConfigFrom(const Config& config);
 ServerLimits serverLimitsFrom(const Config& config);
 // Models resolve relative to the config file's folder.

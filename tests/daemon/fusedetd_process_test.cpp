@@ -1,0 +1,233 @@
+// fusedetd as a process, the way systemd runs it: READY=1 / STATUS= / WATCHDOG=1 / STOPPING=1 on
+// a test NOTIFY_SOCKET, SIGHUP reload with a bad and then a good file while a client stays
+// connected, SIGTERM exit within 2 s, socket activation through systemd-socket-activate, and
+// clear start-up errors. No hardware: the laser port does not exist and keeps reconnecting.
+
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "fusedet/daemon/client.h"
+
+extern char** environ;
+
+using namespace fusedet::daemon;
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kDaemon = std::string(FUSEDET_BINARY_DIR) + "/tools/fusedetd";
+
+fs::path tempDir(const std::string& name) {
+  auto dir = fs::temp_directory_path() / ("fusedetd-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string model(const std::string& cls) { return std::string(FUSEDET_SOURCE_DIR) + "/models/" + cls + ".json"; }
+
+void writeConfig(const fs::path& file, const std::string& socket, const std::vector<std::string>& classes,
+                 const std::string& extra = "") {
+  std::ofstream out(file);
+  out << "socket:\n  path: " << socket << "\nlaser:\n  device: /nonexistent/fusedet-test-ttyUSB\n"
+      << "  reconnect_max_s: 0.5\ncamera:\n  calibration: " << FUSEDET_SOURCE_DIR
+      << "/tests/daemon/data/camera.yaml\ndetection:\n  models: [";
+  for (std::size_t i = 0; i < classes.size(); ++i) out << (i ? ", " : "") << model(classes[i]);
+  out << "]\n" << extra;
+}
+
+class Process {
+ public:
+  Process(std::vector<std::string> argv, std::vector<std::string> env, const fs::path& log) {
+    std::vector<char*> args, envp;
+    for (auto& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    for (char** e = environ; *e; ++e) envp.push_back(*e);
+    for (auto& e : env) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), envp.data()) != 0) pid_ = -1;
+    posix_spawn_file_actions_destroy(&fa);
+  }
+  ~Process() {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  pid_t pid() const { return pid_; }
+  // Exit status, or -1 if still running after `timeout`.
+  int wait(std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        exited_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      }
+      if (std::chrono::steady_clock::now() > end) return -1;
+      std::this_thread::sleep_for(5ms);
+    }
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+};
+
+// A datagram socket standing in for systemd's notification socket.
+class NotifySocket {
+ public:
+  explicit NotifySocket(const fs::path& path) : path_(path) {
+    fd_.reset(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
+    sockaddr_un a{};
+    a.sun_family = AF_UNIX;
+    std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
+    if (::bind(fd_.get(), reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) throw std::runtime_error("bind notify");
+  }
+  std::string env() const { return "NOTIFY_SOCKET=" + path_.string(); }
+  // Waits for a message containing `needle`; every message seen is kept in `seen`.
+  bool waitFor(const std::string& needle, std::chrono::milliseconds timeout) {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < end) {
+      pollfd p{fd_.get(), POLLIN, 0};
+      if (::poll(&p, 1, 50) <= 0) continue;
+      char buf[4096];
+      const ssize_t n = ::recv(fd_.get(), buf, sizeof buf, 0);
+      if (n <= 0) continue;
+      seen.emplace_back(buf, static_cast<std::size_t>(n));
+      if (seen.back().find(needle) != std::string::npos) return true;
+    }
+    return false;
+  }
+  int count(const std::string& needle) const {
+    int n = 0;
+    for (const auto& s : seen) n += s.find(needle) != std::string::npos;
+    return n;
+  }
+  std::vector<std::string> seen;
+
+ private:
+  fs::path path_;
+  fusedet::drivers::UniqueFd fd_;
+};
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+nlohmann::json ask(Client& c, const std::string& cmd) {
+  c.send({{"cmd", cmd}});
+  auto r = c.read(10s);
+  return r ? *r : nlohmann::json();
+}
+
+}  // namespace
+
+TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
+  const fs::path dir = tempDir("notify");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
+  writeConfig(config, socket, {"car", "bike", "person"});
+  NotifySocket notify(dir / "notify");
+  Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=400000"}, dir / "log");
+  ASSERT_GT(daemon.pid(), 0);
+  ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
+  EXPECT_NE(notify.seen.back().find("STATUS=live: laser"), std::string::npos) << notify.seen.back();
+  // READY=1 means served: a client gets its hello at once.
+  Client client(socket.string());
+  EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
+  // Watchdog pings at a quarter..half of WATCHDOG_USEC while the pipeline threads are alive.
+  notify.seen.clear();
+  notify.waitFor("never sent", 1500ms);
+  EXPECT_GE(notify.count("WATCHDOG=1"), 3);
+
+  // A broken file: the running configuration stays, STATUS= and `status` say why.
+  { std::ofstream(config) << "detection:\n  modles: []\n"; }
+  ::kill(daemon.pid(), SIGHUP);
+  ASSERT_TRUE(notify.waitFor("reload failed", 10s)) << readFile(dir / "log");
+  const auto status = ask(client, "status");
+  EXPECT_NE(status["last_reload_error"].get<std::string>().find("unknown key detection.modles"), std::string::npos)
+      << status.dump();
+  EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
+  // A good one applies, the same connection stays.
+  writeConfig(config, socket, {"bike"});
+  ::kill(daemon.pid(), SIGHUP);
+  bool applied = false;
+  for (int i = 0; i < 100 && !applied; ++i) {
+    applied = ask(client, "hello")["classes"] == nlohmann::json({"bike"});
+    if (!applied) std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_TRUE(applied);
+  EXPECT_EQ(ask(client, "status")["clients"]["disconnected"], 0);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  ::kill(daemon.pid(), SIGTERM);
+  const int rc = daemon.wait(5s);
+  const auto took = std::chrono::steady_clock::now() - t0;
+  EXPECT_EQ(rc, 0) << readFile(dir / "log");
+  EXPECT_LT(took, 2s);
+  EXPECT_TRUE(notify.waitFor("STOPPING=1", 1s) || notify.count("STOPPING=1") > 0);
+  EXPECT_FALSE(client.read(1s));
+  EXPECT_TRUE(client.closed());
+}
+
+TEST(Fusedetd, SocketActivationUsesThePassedSocket) {
+  if (::access("/usr/bin/systemd-socket-activate", X_OK) != 0) GTEST_SKIP() << "systemd-socket-activate missing";
+  const fs::path dir = tempDir("activate");
+  const fs::path config = dir / "fusedet.yaml", activated = dir / "activated.sock", configured = dir / "configured.sock";
+  writeConfig(config, configured, {"car"});
+  Process daemon({"/usr/bin/systemd-socket-activate", "-l", activated.string(), kDaemon, "--config", config.string()}, {},
+                 dir / "log");
+  // systemd-socket-activate binds at once; the daemon then takes the socket as fd 3.
+  std::unique_ptr<Client> client;
+  for (int i = 0; i < 200 && !client; ++i) {
+    try {
+      client = std::make_unique<Client>(activated.string());
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  ASSERT_TRUE(client);
+  EXPECT_EQ(ask(*client, "hello")["classes"], nlohmann::json({"car"})) << readFile(dir / "log");
+  EXPECT_FALSE(fs::exists(configured));  // the configured path was not bound
+  EXPECT_NE(readFile(dir / "log").find("socket systemd passed"), std::string::npos);
+  ::kill(daemon.pid(), SIGTERM);
+  EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+}
+
+TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
+  const fs::path dir = tempDir("errors");
+  const fs::path config = dir / "fusedet.yaml";
+  writeConfig(config, dir / "a.sock", {"car"}, "");
+  {
+    std::string text = readFile(config);
+    text.replace(text.find("tests/daemon/data/camera.yaml"), 29, "tests/daemon/data/missing.yaml");
+    std::ofstream(config) << text;
+  }
+  Process bad({kDaemon, "--config", config.string()}, {}, dir / "log1");
+  EXPECT_EQ(bad.wait(60s), 1);
+  EXPECT_NE(readFile(dir / "log1").find("missing.yaml"), std::string::npos) << readFile(dir / "log1");
+
+  writeConfig(config, dir / "b.sock", {"car"}, "replay:\n  file: /tmp/some.mcap\n");
+  Process replay({kDaemon, "--config", config.string()}, {}, dir / "log2");
+  EXPECT_EQ(replay.wait(60s), 1);
+  EXPECT_NE(readFile(dir / "log2").find("replay"), std::string::npos) << readFile(dir / "log2");
+}
