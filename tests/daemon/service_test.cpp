@@ -12,7 +12,7 @@
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/scene_source.h"
 #include "fusedet/daemon/service.h"
-#include "kitti_scenes.h"
+#include "fusedet/daemon/kitti_scenes.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -26,6 +26,8 @@ std::string tempSocket(const std::string& name) {
   return (dir / name).string();
 }
 
+std::filesystem::path kittiRoot() { return std::filesystem::path(FUSEDET_DATA_DIR) / "kitti"; }
+
 std::string model(const std::string& cls) { return std::string(FUSEDET_SOURCE_DIR) + "/models/" + cls + ".json"; }
 
 Config testConfig(const std::string& socket) {
@@ -35,7 +37,7 @@ Config testConfig(const std::string& socket) {
   return c;
 }
 
-ServiceParts parts(const Config& config, const kitti_scenes::KittiScenes& k, std::unique_ptr<Source> source,
+ServiceParts parts(const Config& config, const KittiScenes& k, std::unique_ptr<Source> source,
                    std::shared_ptr<const StackDetector> detector = nullptr) {
   ServiceParts p;
   p.config = config;
@@ -53,7 +55,7 @@ struct Label3d {
   Eigen::Vector3d centre;
 };
 Label3d kittiLabel(const std::string& id, const std::string& cls) {
-  std::ifstream in(kitti_scenes::kittiRoot() / "label_2" / (id + ".txt"));
+  std::ifstream in(kittiRoot() / "label_2" / (id + ".txt"));
   std::string line;
   while (std::getline(in, line)) {
     std::istringstream s(line);
@@ -77,7 +79,7 @@ bool waitFor(const std::function<bool()>& done, std::chrono::milliseconds timeou
 }  // namespace
 
 TEST(Service, ClientsGetEveryStackWithPositionsMatchingKittiLabels) {
-  const auto k = kitti_scenes::loadKittiScenes(kitti_scenes::kittiRoot(), {"000105", "000108"});
+  const auto k = loadKittiScenes(kittiRoot(), {"000105", "000108"});
   const Config config = testConfig(tempSocket("e2e.sock"));
   auto source = std::make_unique<SceneSource>(k.scenes, 400ms, 2);
   SceneSource* src = source.get();
@@ -148,7 +150,7 @@ TEST(Service, ClientsGetEveryStackWithPositionsMatchingKittiLabels) {
 }
 
 TEST(Service, ReloadUnderLoadKeepsClientsAndABadFileKeepsTheOldModels) {
-  const auto k = kitti_scenes::loadKittiScenes(kitti_scenes::kittiRoot(), {"000105"});
+  const auto k = loadKittiScenes(kittiRoot(), {"000105"});
   const Config config = testConfig(tempSocket("reload.sock"));
   Service service(parts(config, k, std::make_unique<SceneSource>(k.scenes, 150ms, 0)));
   service.start();
@@ -221,7 +223,7 @@ class StallingDetector : public StackDetector {
 }  // namespace
 
 TEST(Service, AStalledDetectionThreadIsNotAliveAndStacksAreDroppedNotQueued) {
-  const auto k = kitti_scenes::loadKittiScenes(kitti_scenes::kittiRoot(), {"000105"});
+  const auto k = loadKittiScenes(kittiRoot(), {"000105"});
   const Config config = testConfig(tempSocket("stall.sock"));
   auto detector = std::make_shared<StallingDetector>();
   Service service(parts(config, k, std::make_unique<SceneSource>(k.scenes, 100ms, 0), detector));

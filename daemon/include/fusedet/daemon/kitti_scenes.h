@@ -1,6 +1,7 @@
 #pragma once
-// Test and benchmark support: real KITTI frames (../shared/data) as the daemon's recorded scenes
-// (Velodyne sweep + camera image) and the Fuser for their calibration.
+// KITTI frames as recorded scenes for SceneSource (Velodyne turn + camera image, each a 0.1 s
+// sweep) and the Fuser for their calibration: the whole daemon on real data without devices
+// (tests, the latency benchmark).
 
 #include <filesystem>
 #include <memory>
@@ -10,14 +11,15 @@
 #include "fusedet/daemon/source.h"
 #include "fusedet/fusion/kitti.h"
 
-namespace fusedet::kitti_scenes {
+namespace fusedet::daemon {
 
 struct KittiScenes {
-  std::vector<daemon::PairedScene> scenes;
+  std::vector<PairedScene> scenes;
   std::shared_ptr<const fusion::Fuser> fuser;  // of the first frame's calibration
   std::vector<fusion::KittiFrame> frames;
 };
 
+// The image as a BGR24 camera frame (what a camera driver would deliver).
 inline drivers::CameraFrame bgrFrame(const cv::Mat& image) {
   drivers::CameraFrame f;
   f.width = image.cols;
@@ -28,12 +30,12 @@ inline drivers::CameraFrame bgrFrame(const cv::Mat& image) {
   return f;
 }
 
-// The given frame ids of the drive at `root` (all of one calibration).
+// The given frame ids of the drive at `root` (all of one calibration). Throws like readKittiFrame.
 inline KittiScenes loadKittiScenes(const std::filesystem::path& root, const std::vector<std::string>& ids) {
   KittiScenes out;
   for (const auto& id : ids) {
     fusion::KittiFrame f = fusion::readKittiFrame(root, id);
-    daemon::PairedScene s;
+    PairedScene s;
     s.sweep = f.points;
     s.sweep.start = Stamp{0};
     s.sweep.end = Stamp{100'000'000};  // a Velodyne turn: 0.1 s
@@ -45,6 +47,4 @@ inline KittiScenes loadKittiScenes(const std::filesystem::path& root, const std:
   return out;
 }
 
-inline std::filesystem::path kittiRoot() { return std::filesystem::path(FUSEDET_DATA_DIR) / "kitti"; }
-
-}  // namespace fusedet::kitti_scenes
+}  // namespace fusedet::daemon
