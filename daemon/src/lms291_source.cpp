@@ -36,7 +36,7 @@ std::vector<SensorHealth> Lms291Source::health() const {
     return {h};
   }
   const auto c = stream_->counters();
-  h.state = std::string(drivers::lms291::toString(stream_->state()));
+  h.state = std::string(drivers::toString(stream_->state()));
   h.messages = c.device.scans;
   h.crcErrors = c.device.link.reader.crcErrors;
   h.reconnects = c.reconnects;

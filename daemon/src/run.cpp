@@ -10,6 +10,7 @@
 
 #include <chrono>
 
+#include "fusedet/daemon/camera_source.h"
 #include "fusedet/daemon/lms291_source.h"
 #include "fusedet/daemon/server.h"
 #include "fusedet/daemon/service.h"
@@ -45,6 +46,7 @@ ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
   parts.fuser = fuserFrom(config, configFile);
   parts.detector = detectorFrom(config, configFile);
   parts.sources.push_back(std::make_unique<Lms291Source>(config.laser));
+  parts.sources.push_back(std::make_unique<CameraSource>(config.camera));
   parts.configFile = configFile;
   parts.config = std::move(config);
   parts.mode = "live";
