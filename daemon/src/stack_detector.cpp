@@ -31,34 +31,30 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
     : scan_(scanParamsFrom(settings)), group_(groupParamsFrom(settings)) {
   if (settings.models.empty()) throw std::runtime_error("detection.models: no model files configured");
   std::set<std::string> seen;
+  std::vector<boosting::Cascade> cascades;
   for (const auto& m : settings.models) {
     std::filesystem::path file = m;
     if (file.is_relative() && !base.empty()) file = base / file;
-    try {
-      boosting::Detector detector(boosting::loadModel(file));
-      const std::string& name = detector.cascade().className;
-      if (!seen.insert(name).second)
-        throw std::runtime_error(file.string() + ": a second model of class '" + name + "'");
-      detectors_.push_back(std::move(detector));
-      files_.push_back(file);
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(file.string() + ": " + e.what());
-    }
+    boosting::Cascade cascade = boosting::loadModel(file);
+    if (!seen.insert(cascade.className).second)
+      throw std::runtime_error(file.string() + ": a second model of class '" + cascade.className + "'");
+    cascades.push_back(std::move(cascade));
+    files_.push_back(file);
+  }
+  try {
+    detector_ = std::make_unique<boosting::MultiDetector>(std::move(cascades));
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("detection.models: ") + e.what());
   }
 }
 
 std::vector<Detection> CascadeSet::detect(const LayerStack& stack) const {
-  std::vector<Detection> all;
-  for (const auto& d : detectors_) {
-    auto found = boosting::detect(d, stack, scan_, group_);
-    all.insert(all.end(), std::make_move_iterator(found.begin()), std::make_move_iterator(found.end()));
-  }
-  return all;
+  return boosting::detect(*detector_, stack, scan_, group_);
 }
 
 std::vector<std::string> CascadeSet::classes() const {
   std::vector<std::string> names;
-  for (const auto& d : detectors_) names.push_back(d.cascade().className);
+  for (std::size_t i = 0; i < detector_->size(); ++i) names.push_back(detector_->cascade(i).className);
   return names;
 }
 

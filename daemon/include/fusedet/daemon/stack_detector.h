@@ -1,15 +1,14 @@
 #pragma once
 // StackDetector: the pipeline's one, narrow detection call - every configured class on one
-// LayerStack. CascadeSet is today's implementation (one boosting::Detector per model file, each
-// with its own reference hue from the model); a faster multi-class detector slots in behind the
-// same interface.
+// LayerStack. CascadeSet implements it with boosting::MultiDetector: all model files in one pass
+// per stack (shared integrals; each model's hue_distance from its own reference hue).
 
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "fusedet/boost/detector.h"
+#include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/core/detection.h"
 #include "fusedet/core/layer_stack.h"
@@ -41,7 +40,7 @@ class CascadeSet : public StackDetector {
   const std::vector<std::filesystem::path>& files() const { return files_; }
 
  private:
-  std::vector<boosting::Detector> detectors_;
+  std::unique_ptr<boosting::MultiDetector> detector_;
   std::vector<std::filesystem::path> files_;
   boosting::ScanParams scan_;
   boosting::GroupParams group_;
