@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 
@@ -20,6 +21,12 @@ std::string fixedString(const std::uint8_t* s, std::size_t n) {
 
 std::string fractionText(Fraction f) {
   return std::to_string(f.numerator) + "/" + std::to_string(f.denominator) + " s";
+}
+
+std::string fpsText(double fps) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", fps);
+  return buf;
 }
 
 }  // namespace
@@ -217,7 +224,7 @@ Result<void> V4l2Camera::setInterval(CameraInfo& info) {
   if (const int err = io_->ioctl(VIDIOC_S_PARM, &p); err != 0) return fail(err, "VIDIOC_S_PARM");
   info.interval = {p.parm.capture.timeperframe.numerator, p.parm.capture.timeperframe.denominator};
   if (!info.interval.valid() || std::abs(1.0 / info.interval.value() - config_.fps) > 0.01 * config_.fps)
-    info.notes.push_back("asked for " + std::to_string(config_.fps) + " fps; the device runs at " +
+    info.notes.push_back("asked for " + fpsText(config_.fps) + " fps; the device runs at " +
                          (info.interval.valid() ? fractionText(info.interval) + " per frame" : std::string("an unknown rate")));
   return {};
 }

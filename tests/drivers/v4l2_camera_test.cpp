@@ -319,7 +319,7 @@ TEST(V4l2Camera, MjpegFramesKeepTheirCompressedSize) {
   EXPECT_EQ(info->format.width, 1280u);
   ASSERT_FALSE(info->notes.empty());
   EXPECT_EQ(info->notes[0], "size 1024x768 is not offered; using 1280x720");
-  EXPECT_EQ(info->notes[1], "asked for 15.000000 fps; the device runs at 1/30 s per frame");
+  EXPECT_EQ(info->notes[1], "asked for 15 fps; the device runs at 1/30 s per frame");
   rig.fake->script = {FakeFrame{0, 0, 12345}};
   auto f = rig.camera->readFrame(100ms);
   ASSERT_TRUE(f);
