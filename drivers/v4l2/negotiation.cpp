@@ -94,16 +94,30 @@ std::string_view toString(FormatChoice choice) {
 
 std::string describeOffers(std::span<const FormatOffer> offers) {
   if (offers.empty()) return "none";
-  std::string s;
+  // Formats with the same sizes are listed together (vivid offers ~40 formats, all alike).
+  std::vector<std::pair<std::string, std::string>> groups;  // fourccs, sizes
   for (const FormatOffer& f : offers) {
-    if (!s.empty()) s += ", ";
-    s += fourccToString(f.fourcc) + " (";
-    if (f.sizes.empty()) s += "sizes not enumerated";
-    for (std::size_t i = 0; i < f.sizes.size(); ++i) {
-      if (i) s += ' ';
-      s += f.sizes[i].toString();
+    std::string sizes;
+    for (const SizeRange& r : f.sizes) {
+      if (!sizes.empty()) sizes += ' ';
+      sizes += r.toString();
     }
-    s += ")";
+    if (sizes.empty()) sizes = "sizes not enumerated";
+    const auto same = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.second == sizes; });
+    if (same != groups.end()) {
+      same->first += ' ';
+      same->first += fourccToString(f.fourcc);
+    } else {
+      groups.emplace_back(fourccToString(f.fourcc), sizes);
+    }
+  }
+  std::string s;
+  for (const auto& [codes, sizes] : groups) {
+    if (!s.empty()) s += ", ";
+    s += codes;
+    s += " (";
+    s += sizes;
+    s += ')';
   }
   return s;
 }

@@ -75,6 +75,10 @@ TEST(V4l2Negotiation, RefusalNamesDeviceWishAndEveryOffer) {
   EXPECT_EQ(r.error().context,
             "camera /dev/video3: wants MJPEG; the device offers YUYV (320x180 640x480), "
             "UYVY (16x16..1920x1080/+2+2), RGB3 (sizes not enumerated)");
+  // Formats with the same sizes are named together (vivid offers ~40 alike).
+  std::vector<FormatOffer> alike{{kYuyv, "", {SizeRange::discrete(640, 480)}}, {kRgb3, "", {}},
+                                 {kUyvy, "", {SizeRange::discrete(640, 480)}}, {V4L2_PIX_FMT_GREY, "", {SizeRange::discrete(640, 480)}}};
+  EXPECT_EQ(describeOffers(alike), "YUYV UYVY GREY (640x480), RGB3 (sizes not enumerated)");
   const auto none = negotiateFormat("/dev/video3", {}, {FormatChoice::kAuto, 640, 480});
   ASSERT_FALSE(none);
   EXPECT_EQ(none.error().context, "camera /dev/video3: wants YUYV or MJPEG; the device offers none");

@@ -88,7 +88,8 @@ struct NegotiatedFormat {
 // the device offers, e.g. "camera /dev/video0: wants MJPEG; offers YUYV (640x480 1280x720), ...".
 Result<NegotiatedFormat> negotiateFormat(const std::string& device, std::span<const FormatOffer> offers,
                                          const CaptureRequest& request);
-// "YUYV (640x480 1280x720), RGB3 (16x16..1920x1080/+2+2)"; "none" when empty.
+// "YUYV UYVY (640x480 1280x720), RGB3 (16x16..1920x1080/+2+2)": formats with the same sizes
+// together, in the order offered; "none" when empty.
 std::string describeOffers(std::span<const FormatOffer> offers);
 
 // The offered frame interval closest to 1/fps (ranges: clamped and rounded to their step).
