@@ -1,19 +1,25 @@
 // fusedet camera: V4L2 cameras.
 //   list          every /dev/videoN: driver, card, capabilities, formats, sizes, frame rates
 //   grab          capture N frames from one device and write them as PNG files
+//   stream        FrameStream as in the daemon: frames until count/duration, with restarts and reopens
 
+#include <atomic>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <thread>
 
 #include "command.h"
 #include "device_exit.h"
 #include "fusedet/drivers/v4l2/camera.h"
 #include "fusedet/drivers/v4l2/device_list.h"
+#include "fusedet/drivers/v4l2/frame_stream.h"
 #include "fusedet/fusion/frame_decode.h"
 
 namespace fusedet::tools {
@@ -36,6 +42,9 @@ struct CameraOptions {
   std::string exposure = "auto", gain = "auto";
   bool raw = false;
   bool json = false;
+  long streamCount = 0;  // stream: 0 = no limit
+  double duration = 0;  // stream
+  int stallMs = 2000;   // stream
 };
 
 int reportError(const char* command, const CameraOptions& o, const Error& e) {
@@ -127,7 +136,8 @@ int runList(const CameraOptions& o) {
 
 std::string extensionOf(drivers::PixelFormat f) { return f == drivers::PixelFormat::kMjpeg ? "mjpg" : "yuyv"; }
 
-int runGrab(const CameraOptions& o) {
+// The capture configuration from the options; an exit code instead when they are unusable.
+std::optional<CameraConfig> configOf(const char* command, const CameraOptions& o, int& exitCode) {
   CameraConfig c;
   c.device = o.device;
   c.format = *parseFormatChoice(o.format);  // CLI11 checked the choice
@@ -137,13 +147,34 @@ int runGrab(const CameraOptions& o) {
   c.buffers = o.buffers;
   const auto exposure = parseControlSetting(o.exposure), gain = parseControlSetting(o.gain);
   if (!exposure || !gain) {
-    std::fprintf(stderr, "fusedet camera grab: error: --%s '%s': expected 'auto' or a non-negative integer\n",
+    std::fprintf(stderr, "fusedet camera %s: error: --%s '%s': expected 'auto' or a non-negative integer\n", command,
                  exposure ? "gain" : "exposure", (exposure ? o.gain : o.exposure).c_str());
-    return kExitUsage;
+    exitCode = kExitUsage;
+    return std::nullopt;
   }
   c.controls.exposure = *exposure;
   c.controls.gain = *gain;
-  if (const std::string why = c.validate(); !why.empty()) return reportError("grab", o, makeError(std::errc::invalid_argument, why));
+  if (const std::string why = c.validate(); !why.empty()) {
+    exitCode = reportError(command, o, makeError(std::errc::invalid_argument, why));
+    return std::nullopt;
+  }
+  return c;
+}
+
+json countersJson(const CameraCounters& c) {
+  return {{"frames", c.frames},           {"bytes", c.bytes},
+          {"lost_frames", c.lostFrames},  {"sequence_gaps", c.sequenceGaps},
+          {"sequence_resets", c.sequenceResets}, {"error_frames", c.errorFrames},
+          {"short_frames", c.shortFrames}, {"host_stamps", c.hostStamps},
+          {"stamps_backwards", c.stampsBackwards}, {"timeouts", c.timeouts},
+          {"buffer_errors", c.bufferErrors}, {"stream_starts", c.streamStarts}};
+}
+
+int runGrab(const CameraOptions& o) {
+  int code = kExitOk;
+  const auto config = configOf("grab", o, code);
+  if (!config) return code;
+  const CameraConfig& c = *config;
   if (!o.out.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(o.out, ec);
@@ -217,12 +248,7 @@ int runGrab(const CameraOptions& o) {
       {"restarts", restarts},
       {"stamps_increasing", counters.stampsBackwards == 0},
       {"raw_buffers", raws.size()},
-      {"counters",
-       {{"frames", counters.frames}, {"bytes", counters.bytes}, {"lost_frames", counters.lostFrames},
-        {"sequence_gaps", counters.sequenceGaps}, {"sequence_resets", counters.sequenceResets},
-        {"error_frames", counters.errorFrames}, {"short_frames", counters.shortFrames},
-        {"host_stamps", counters.hostStamps}, {"stamps_backwards", counters.stampsBackwards}, {"timeouts", counters.timeouts},
-        {"buffer_errors", counters.bufferErrors}, {"stream_starts", counters.streamStarts}}},
+      {"counters", countersJson(counters)},
       {"frames", list}};
   if (o.json) {
     std::printf("%s\n", summary.dump().c_str());
@@ -238,6 +264,54 @@ int runGrab(const CameraOptions& o) {
                 (unsigned long long)counters.frames, (unsigned long long)counters.lostFrames,
                 (unsigned long long)counters.sequenceGaps, (unsigned long long)counters.errorFrames,
                 (unsigned long long)counters.shortFrames, (unsigned long long)counters.hostStamps, restarts);
+  }
+  return kExitOk;
+}
+
+std::atomic<bool> gStreamStop{false};
+extern "C" void onCameraSignal(int) { gStreamStop = true; }
+
+// FrameStream as the daemon runs it: stall restarts, reopen after the device vanished.
+int runStream(const CameraOptions& o) {
+  int code = kExitOk;
+  const auto config = configOf("stream", o, code);
+  if (!config) return code;
+  std::signal(SIGINT, onCameraSignal);
+  std::signal(SIGTERM, onCameraSignal);
+  FrameStreamTiming timing;
+  timing.stallLimit = std::chrono::milliseconds(o.stallMs);
+  std::atomic<long> received{0};
+  FrameStream stream(*config, [&](const drivers::CameraFrame& f) {
+    if (o.streamCount > 0 && received >= o.streamCount) return;
+    ++received;
+    if (o.json)
+      std::printf("%s\n", json{{"sequence", f.sequence}, {"stamp", f.stamp.toString()}, {"bytes", f.bytes.size()}}.dump().c_str());
+    else
+      std::printf("frame %llu  stamp %s  %zu bytes\n", static_cast<unsigned long long>(f.sequence), f.stamp.toString().c_str(),
+                  f.bytes.size());
+    std::fflush(stdout);
+  }, timing);
+  stream.start();
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!gStreamStop && (o.streamCount <= 0 || received < o.streamCount) &&
+         (o.duration <= 0 || std::chrono::steady_clock::now() - t0 < std::chrono::duration<double>(o.duration)))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  stream.stop();
+  const FrameStreamCounters c = stream.counters();
+  const json summary{{"device", o.device},           {"received", received.load()},     {"counters", countersJson(c.camera)},
+                     {"stalls", c.stalls},           {"stream_restarts", c.streamRestarts}, {"reopens", c.reopens},
+                     {"failed_opens", c.failedOpens}, {"last_error", c.lastError}};
+  if (o.json)
+    std::printf("%s\n", json{{"summary", summary}}.dump().c_str());
+  else
+    std::fprintf(stderr, "camera: %ld frames, %llu lost, %llu stalls, %llu stream restarts, %llu reopens, %llu failed opens%s%s\n",
+                 received.load(), (unsigned long long)c.camera.lostFrames, (unsigned long long)c.stalls,
+                 (unsigned long long)c.streamRestarts, (unsigned long long)c.reopens, (unsigned long long)c.failedOpens,
+                 c.lastError.empty() ? "" : "; last error: ", c.lastError.c_str());
+  if (received == 0) {
+    std::fprintf(stderr, "fusedet camera stream: error: no frame from %s%s%s\n", o.device.c_str(),
+                 c.lastError.empty() ? "" : ": ", c.lastError.c_str());
+    return kExitTimeout;
   }
   return kExitOk;
 }
@@ -270,6 +344,23 @@ const bool registered = registerCommand(
       grab->add_option("--gain", o->gain, "auto, or a fixed gain in device units")->capture_default_str();
       grab->add_flag("--raw", o->raw, "also write each raw buffer as seen by the recording hook (buffer_NNNN.yuyv|.mjpg)");
       grab->add_flag("--json", o->json, "print one JSON summary (format, interval, counters, frames[sequence, stamp, bytes, file])");
+      CLI::App* stream = app.add_subcommand(
+          "stream", "run the camera as the daemon does (restart a stalled stream, reopen a vanished device) and print frames until --count/--duration/Ctrl-C");
+      stream->add_option("--device", o->device, "V4L2 capture node, e.g. /dev/video0")->required();
+      stream->add_option("--count", o->streamCount, "stop after N frames (0 = no limit)")->capture_default_str();
+      stream->add_option("--duration", o->duration, "stop after S seconds (0 = no limit)")->capture_default_str();
+      stream->add_option("--stall-ms", o->stallMs, "no frame this long: restart the stream (twice), then reopen")
+          ->capture_default_str()->check(CLI::Range(100, 600000));
+      stream->add_flag("--json", o->json, "one JSON object per frame (sequence, stamp, bytes), then {\"summary\": {counters, stalls, stream_restarts, reopens, failed_opens, last_error}}");
+      stream->add_option("--format", o->format, "yuyv | mjpeg | auto (as for grab)")
+          ->capture_default_str()
+          ->check(CLI::IsMember({"auto", "yuyv", "mjpeg"}));
+      stream->add_option("--width", o->width, "requested width")->capture_default_str();
+      stream->add_option("--height", o->height, "requested height")->capture_default_str();
+      stream->add_option("--fps", o->fps, "requested frame rate")->capture_default_str();
+      stream->add_option("--buffers", o->buffers, "mmap buffers to request (4..32)")->capture_default_str();
+      stream->add_option("--exposure", o->exposure, "auto, or a fixed exposure in microseconds")->capture_default_str();
+      stream->add_option("--gain", o->gain, "auto, or a fixed gain in device units")->capture_default_str();
       const std::string footer =
           std::string("Frames are captured first and written afterwards, so writing never makes the driver drop frames.\n"
                       "grab reports lost frames (gaps in the driver's sequence numbers), error and short buffers, frames\n"
@@ -281,10 +372,11 @@ const bool registered = registerCommand(
                       "  fusedet camera grab --device /dev/video0 --count 100 --restart-every 50 --json | jq .counters\n"
                       "  fusedet camera grab --device /dev/video0 --format mjpeg --exposure 10000 --gain 0 --out /tmp/f\n") +
           kDeviceExitHelp;
-      for (CLI::App* a : {&app, list, grab}) a->footer(footer);
-      return [o, list, grab]() -> int {
+      for (CLI::App* a : {&app, list, grab, stream}) a->footer(footer);
+      return [o, list, grab, stream]() -> int {
         if (list->parsed()) return runList(*o);
         if (grab->parsed()) return runGrab(*o);
+        if (stream->parsed()) return runStream(*o);
         return kExitUsage;
       };
     });

@@ -34,6 +34,11 @@ std::vector<std::uint32_t> candidates(FormatChoice choice) {
 }  // namespace
 
 std::string fourccToString(std::uint32_t fourcc) {
+  constexpr std::uint32_t kBigEndian = 1u << 31;  // V4L2_PIX_FMT_FLAG_BE on a 4-letter code
+  if ((fourcc & kBigEndian) && (fourcc & ~kBigEndian) >> 24 >= 0x20) {
+    const std::string base = fourccToString(fourcc & ~kBigEndian);
+    if (base.rfind("0x", 0) != 0) return base + "-BE";
+  }
   std::string s;
   for (int i = 0; i < 4; ++i) {
     const char c = static_cast<char>((fourcc >> (8 * i)) & 0xFF);

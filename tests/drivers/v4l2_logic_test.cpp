@@ -32,6 +32,8 @@ TEST(V4l2Fourcc, NamesAndPixelFormats) {
   EXPECT_EQ(fourccToString(V4L2_PIX_FMT_GREY), "GREY");
   EXPECT_EQ(fourccToString(V4L2_PIX_FMT_Y10), "Y10");  // "Y10 " padded with a space
   EXPECT_EQ(fourccToString(0x00000001u), "0x00000001");
+  EXPECT_EQ(fourccToString(V4L2_PIX_FMT_Y16_BE), "Y16-BE");  // big-endian flag on "Y16 "
+  EXPECT_EQ(fourccToString(V4L2_PIX_FMT_XRGB555X), "XR15-BE");
   EXPECT_EQ(kFourccYuyv, kYuyv);
   EXPECT_EQ(kFourccMjpeg, kMjpg);
   EXPECT_EQ(pixelFormatOf(kYuyv), PixelFormat::kYuyv);
