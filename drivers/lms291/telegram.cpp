@@ -70,7 +70,12 @@ Stamp TelegramReader::telegramArrival(std::size_t endOffset, std::size_t frameSi
     }
   Stamp t = arrival(endOffset);
   if (lastTelegramEnd_.ns != 0) t = std::max(t, lastTelegramEnd_ + static_cast<std::int64_t>(frameSize) * byteNs_);
-  return std::min(t, readAt);
+  t = std::min(t, readAt);
+  // When a backlog pushed the previous telegram up to this read's time, the read-time bound
+  // would give this one the same stamp: order wins by a nanosecond, so stamps stay strictly
+  // increasing (equal stamps would make two scans indistinguishable downstream).
+  if (lastTelegramEnd_.ns != 0) t = std::max(t, lastTelegramEnd_ + std::int64_t{1});
+  return t;
 }
 
 void TelegramReader::clear() {

@@ -154,6 +154,27 @@ TEST(LmsTelegram, TelegramsEndingInsideAChunkAreStampedByLineTime) {
   EXPECT_EQ(split->telegram.received.ns, 3'000'000'000);
 }
 
+// A read that returns sooner after the previous one than its telegrams' line time (the kernel
+// buffered them during a backlog): both bounds collide at the read time, and the stamps must
+// still be strictly increasing so that two scans never share a stamp.
+TEST(LmsTelegram, BackloggedTelegramsInOneReadKeepStrictlyIncreasingStamps) {
+  const Bytes reply{0x02, 0x80, 0x03, 0x00, 0xA0, 0x00, 0x10, 0x16, 0x0A};
+  TelegramReader reader;
+  reader.setByteTime(20'000);
+  reader.feed(reply, fusedet::Stamp{1'000'000'000});
+  auto earlier = reader.next();
+  ASSERT_TRUE(earlier);
+  const fusedet::Stamp readAt{1'000'010'000};  // 10 us later, 18 bytes (360 us of line) in it
+  reader.feed(cat(reply, reply), readAt);
+  auto first = reader.next();
+  auto second = reader.next();
+  ASSERT_TRUE(first && second);
+  EXPECT_GT(first->telegram.received, earlier->telegram.received);
+  EXPECT_GT(second->telegram.received, first->telegram.received);
+  EXPECT_LE(first->telegram.received, readAt);
+  EXPECT_LE(second->telegram.received - readAt, 1);  // at most the tie-breaking nanosecond
+}
+
 TEST(LmsTelegram, PowerOnTelegramText) {
   TelegramReader reader;
   reader.feed(cat(cat(cat({0x02, 0x81, 0x17, 0x00, 0x90}, "LMS200;301063;V02.06 "), Bytes{0x13}), Bytes{0x64, 0x5A}));
