@@ -122,6 +122,8 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     if (c.laser.angleDeg == 180 && c.laser.resolutionDeg == 0.25)
       s.fail(YAML::Node(), "laser: resolution_deg 0.25 needs angle_deg 100 (the LMS rejects 180/0.25)");
     s.read("remission", c.laser.remission);
+    s.readOneOf<std::string>("range_unit", c.laser.rangeUnit, {"mm", "cm"});
+    s.readRange("remission_full_scale", c.laser.remissionFullScale, 1e-3, 1e6);
     s.readRange("reconnect_max_s", c.laser.reconnectMaxS, 0.1, 600.0);
     s.finish();
   }
@@ -226,6 +228,8 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "angle_deg" << YAML::Value << c.laser.angleDeg;
   out << YAML::Key << "resolution_deg" << YAML::Value << c.laser.resolutionDeg;
   out << YAML::Key << "remission" << YAML::Value << c.laser.remission;
+  out << YAML::Key << "range_unit" << YAML::Value << c.laser.rangeUnit;
+  out << YAML::Key << "remission_full_scale" << YAML::Value << c.laser.remissionFullScale;
   out << YAML::Key << "reconnect_max_s" << YAML::Value << c.laser.reconnectMaxS << YAML::EndMap;
   out << YAML::Key << "tilt" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "interface" << YAML::Value << c.tilt.interface;

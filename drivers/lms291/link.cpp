@@ -53,10 +53,7 @@ LinkCounters Link::counters() const {
 }
 
 Result<std::optional<StreamEvent>> Link::nextEvent(Clock::time_point deadline) {
-  // The LMS leaves at most 14 ms between the bytes of a telegram: a longer silence means a
-  // pending "frame" was garbage (e.g. a stray STX with a large length).
-  const auto gap = std::chrono::microseconds(
-      std::max<std::int64_t>(20'000, static_cast<std::int64_t>(byteSeconds(std::max(port_.baud(), 1)) * 1e6 * 20)));
+  const auto gap = silenceGap(port_.baud());
   std::array<std::uint8_t, 16384> buffer{};
   for (;;) {
     if (auto e = reader_.next()) return std::optional<StreamEvent>(std::move(*e));

@@ -12,8 +12,6 @@ namespace fusedet::drivers::lms291 {
 
 namespace {
 
-constexpr double kMirrorHz = 75.0;  // one mirror rotation = one (partial) scan (§5)
-
 Error protocolError(const std::string& what) { return makeError(std::errc::protocol_error, what); }
 
 std::string hex(std::uint8_t v) {
@@ -53,7 +51,9 @@ Lms291::Lms291(Lms291Config config) : config_(std::move(config)) {
 Lms291Counters Lms291::counters() const {
   Lms291Counters c = counters_;
   c.link = link_.counters();
-  c.lostScans += assembler_.droppedGroups();
+  c.scans = decoder_.scans();
+  c.lostScans = decoder_.lostScans();
+  c.badScans = decoder_.badScans();
   return c;
 }
 
@@ -203,14 +203,12 @@ Result<DeviceInfo> Lms291::start() {
   if (!cfg) return cfg.error();
   ConfigBlock wanted = *cfg;
   wanted.bytes[5] = config_.remission ? kMeasuringRemission : config_.measuringMode;
-  wanted.bytes[6] = 1;  // mm
+  wanted.bytes[6] = config_.unit == Unit::kMm ? 1 : 0;
   wanted.bytes[4] = static_cast<std::uint8_t>(config_.realTimeIndices ? (wanted.bytes[4] | 0x02) : (wanted.bytes[4] & ~0x02));
   if (wanted.bytes != cfg->bytes) {
     // The configuration lives in EEPROM: write only what changed.
     if (auto r = writeConfig(wanted); !r) return r.error();
   }
-  activeMeasuringMode_ = wanted.bytes[5];
-  activeUnit_ = Unit::kMm;
 
   if (auto r = setVariant(config_.variant); !r) return r.error();
   auto status = queryStatus();
@@ -219,8 +217,7 @@ Result<DeviceInfo> Lms291::start() {
   if (status->angleDeg != config_.variant.angleDeg || status->resolutionCdeg != config_.variant.resolutionCdeg)
     return protocolError("device reports " + std::to_string(status->angleDeg) + " deg / " +
                          std::to_string(status->resolutionCdeg) + " cdeg after setting the variant");
-  assembler_.reset(config_.variant);
-  lastTelegramIndex_.reset();
+  decoder_.reset(config_.variant, config_.remission, wanted.bytes[5], config_.unit);
 
   if (config_.remission) {
     std::vector<std::uint8_t> params;
@@ -265,76 +262,9 @@ void Lms291::noteStatus(std::uint8_t status) {
   lastStatus_ = s;
 }
 
-LaserScan Lms291::makeScan(const Telegram& t, std::size_t beams) const {
-  LaserScan scan;
-  // Stamp = reception of the last byte minus the telegram's line time at the current speed.
-  const double lineSeconds = byteSeconds(link_.baud()) * static_cast<double>(t.size());
-  scan.stamp = t.received - static_cast<std::int64_t>(lineSeconds * 1e9);
-  const Variant v = config_.variant;
-  scan.startAngle = v.startDeg() * M_PI / 180.0;
-  scan.angleStep = v.resolutionCdeg / 100.0 * M_PI / 180.0;
-  // Beams of one rotation follow the mirror; interlaced beams come from several rotations.
-  scan.beamDuration = v.rotations() == 1 ? (v.resolutionCdeg / 100.0 / 360.0) / kMirrorHz : 0.0;
-  scan.status = t.status.value_or(0);
-  scan.ranges.reserve(beams);
-  return scan;
-}
-
 std::optional<LaserScan> Lms291::handle(const Telegram& t) {
-  const std::size_t beams = static_cast<std::size_t>(config_.variant.beams());
   if (t.status) noteStatus(*t.status);
-  if (t.command == kMeasuredValues && !config_.remission) {
-    auto mv = decodeMeasuredValues(t.data);
-    if (!mv || mv->countWord.unit != activeUnit_) {
-      ++counters_.badScans;
-      return std::nullopt;
-    }
-    // Telegram-index gaps count lost scans in full-scan modes; with partial scans the
-    // assembler counts the groups that a lost partial broke.
-    if (mv->telegramIndex && !mv->countWord.partial) {
-      if (lastTelegramIndex_) {
-        const int gap = (*mv->telegramIndex - *lastTelegramIndex_ - 1 + 256) % 256;
-        counters_.lostScans += static_cast<std::uint64_t>(gap);
-        sequence_ += static_cast<std::uint64_t>(gap);
-      }
-      lastTelegramIndex_ = mv->telegramIndex;
-    }
-    std::vector<std::uint16_t> values;
-    if (mv->countWord.partial) {
-      auto merged = assembler_.add(mv->countWord.partialIndex, mv->values);
-      if (!merged) return std::nullopt;
-      values = std::move(*merged);
-    } else {
-      if (mv->values.size() != beams) {
-        ++counters_.badScans;
-        return std::nullopt;
-      }
-      values = std::move(mv->values);
-    }
-    LaserScan scan = makeScan(t, beams);
-    for (std::uint16_t v : values) scan.ranges.push_back(valueToMeters(v, activeMeasuringMode_, activeUnit_));
-    scan.sequence = sequence_++;
-    ++counters_.scans;
-    return scan;
-  }
-  if (t.command == kRangeRemission && config_.remission) {
-    auto blocks = decodeRangeRemission(t.data);
-    if (!blocks || blocks->size() != 1 || (*blocks)[0].ranges.size() != beams ||
-        (*blocks)[0].countWord.unit != activeUnit_) {
-      ++counters_.badScans;
-      return std::nullopt;
-    }
-    const RemissionBlock& b = (*blocks)[0];
-    LaserScan scan = makeScan(t, beams);
-    for (std::size_t i = 0; i < beams; ++i) {
-      scan.ranges.push_back(valueToMeters(b.ranges[i], activeMeasuringMode_, activeUnit_));
-      scan.remissions.push_back(static_cast<float>(b.remissions[i]));
-    }
-    scan.sequence = sequence_++;
-    ++counters_.scans;
-    return scan;
-  }
-  return std::nullopt;  // replies and power-on telegrams are not scans
+  return decoder_.decode(t, link_.baud());
 }
 
 Result<LaserScan> Lms291::readScan(std::chrono::milliseconds timeout) {

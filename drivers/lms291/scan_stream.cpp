@@ -14,6 +14,13 @@ ScanStream::ScanStream(Lms291Config config, ScanHandler onScan, std::chrono::mil
 
 ScanStream::~ScanStream() { (void)stop(); }
 
+void ScanStream::setRecorder(logs::Recorder* recorder) {
+  // Runs on the stream thread, where reading the link's current speed is safe.
+  setRawHook([this, recorder](std::span<const std::uint8_t> bytes, Stamp stamp) {
+    recorder->record(logs::SerialChunk{stamp, device_.config().device, device_.link().baud(), {bytes.begin(), bytes.end()}});
+  });
+}
+
 void ScanStream::start() {
   if (running_.exchange(true)) return;
   cancel_ = false;

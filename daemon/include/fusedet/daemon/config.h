@@ -33,6 +33,8 @@ struct Config {
     int angleDeg = 180;
     double resolutionDeg = 0.5;
     bool remission = false;
+    std::string rangeUnit = "mm";  // mm | cm
+    double remissionFullScale = 1000.0;  // raw remission value that maps to 1 in the remission layer
     double reconnectMaxS = 5.0;
   } laser;
 

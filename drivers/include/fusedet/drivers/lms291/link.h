@@ -3,6 +3,7 @@
 // waits for the lone ACK (NAK => wait 30 ms and resend), then for the reply (request | 0x80),
 // retrying on silence; while waiting, streamed telegrams are passed over and counted.
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -11,10 +12,18 @@
 #include <string>
 
 #include "fusedet/core/result.h"
+#include "fusedet/drivers/lms291/protocol.h"
 #include "fusedet/drivers/lms291/telegram.h"
 #include "fusedet/drivers/serial_port.h"
 
 namespace fusedet::drivers::lms291 {
+
+// The LMS leaves at most 14 ms between the bytes of a telegram: a longer silence (at least 20 ms,
+// or 20 byte times at slow speeds) means a pending "frame" was garbage and is given up.
+inline std::chrono::microseconds silenceGap(int baud) {
+  return std::chrono::microseconds(
+      std::max<std::int64_t>(20'000, static_cast<std::int64_t>(byteSeconds(std::max(baud, 1)) * 1e6 * 20)));
+}
 
 struct LinkCounters {
   ReaderCounters reader;          // bytes, telegrams, CRC errors, resyncs, ACK/NAK bytes

@@ -14,7 +14,7 @@
 #include "fusedet/core/result.h"
 #include "fusedet/drivers/lms291/link.h"
 #include "fusedet/drivers/lms291/protocol.h"
-#include "fusedet/drivers/lms291/scan_assembler.h"
+#include "fusedet/drivers/lms291/scan_decoder.h"
 #include "fusedet/drivers/messages.h"
 
 namespace fusedet::drivers::lms291 {
@@ -27,6 +27,7 @@ struct Lms291Config {
   bool interlaced = false;           // stream partial scans (mode 2A) and merge them here
   bool realTimeIndices = false;      // ask for scan/telegram indices: lost scans become visible
   std::uint8_t measuringMode = kMeasuring8m;  // config byte 5 (remission forces 0x0D)
+  Unit unit = Unit::kMm;             // config byte 6: mm (8 m in 13-bit modes) or cm (80 m)
   bool forceTermios2 = false;        // set speeds with BOTHER even where cfsetspeed works
   std::chrono::milliseconds ackTimeout{100};
   std::chrono::milliseconds replyTimeout{1000};
@@ -89,19 +90,14 @@ class Lms291 {
  private:
   RequestOptions options(std::chrono::milliseconds replyTimeout) const;
   std::optional<LaserScan> handle(const Telegram& t);
-  LaserScan makeScan(const Telegram& t, std::size_t beams) const;
   void noteStatus(std::uint8_t status);
 
   Lms291Config config_;
   Link link_;
-  ScanAssembler assembler_;
-  Lms291Counters counters_;
-  std::uint8_t activeMeasuringMode_ = kMeasuring8m;
-  Unit activeUnit_ = Unit::kMm;
+  ScanDecoder decoder_;     // telegrams -> scans (shared with log replay)
+  Lms291Counters counters_;  // statusWarnings and inits; scan counts come from decoder_
   bool streaming_ = false;
   bool stopping_ = false;  // stop(): fewer retries
-  std::optional<std::uint8_t> lastTelegramIndex_;
-  std::uint64_t sequence_ = 0;
   StatusByte lastStatus_;
 };
 

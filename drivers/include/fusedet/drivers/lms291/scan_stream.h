@@ -15,6 +15,7 @@
 
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/stream_state.h"
+#include "fusedet/drivers/log/recorder.h"
 
 namespace fusedet::drivers::lms291 {
 
@@ -41,6 +42,11 @@ class ScanStream {
   void setRawHook(std::function<void(std::span<const std::uint8_t>, Stamp)> hook) {
     device_.link().setRawHook(std::move(hook));
   }
+
+  // Recording hook for sensor logs: every chunk read from the port goes to `recorder` as a
+  // logs::SerialChunk (device path, line speed at the read). Call before start(); the recorder
+  // must outlive the stream.
+  void setRecorder(logs::Recorder* recorder);
 
   void start();
   // Streaming off, device back to 9600 (if reachable), thread joined. Returns the result of

@@ -1,0 +1,274 @@
+#include "fusedet/drivers/log/channels.h"
+
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "fusedet/drivers/log/base64.h"
+
+namespace fusedet::drivers::logs {
+
+using nlohmann::json;
+
+namespace {
+
+// Schema texts: written for fusedet from the field lists of docs/log-format.md; the foxglove.*
+// ones carry the fields Foxglove's viewers read (extra fusedet fields are allowed by JSON Schema).
+constexpr char kTimeProp[] = R"("timestamp":{"type":"object","properties":{"sec":{"type":"integer"},"nsec":{"type":"integer"}}})";
+constexpr char kVec3[] = R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"}}})";
+constexpr char kQuat[] = R"({"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"},"z":{"type":"number"},"w":{"type":"number"}}})";
+
+std::string object(const std::string& title, const std::string& props) {
+  return R"({"title":")" + title + R"(","type":"object","properties":{)" + kTimeProp + "," + props + "}}";
+}
+std::string pose() { return std::string(R"("pose":{"type":"object","properties":{"position":)") + kVec3 + R"(,"orientation":)" + kQuat + "}}"; }
+const std::string kBytes = R"({"type":"string","contentEncoding":"base64"})";
+const std::string kNumberArray = R"({"type":"array","items":{"type":"number"}})";
+
+const std::string& schemaText(Schema s) {
+  static const std::string texts[] = {
+      object("fusedet.RawSerial", R"("device":{"type":"string"},"baud":{"type":"integer"},"data":)" + kBytes),
+      object("fusedet.CanFrame", R"("interface":{"type":"string"},"id":{"type":"integer"},"extended":{"type":"boolean"},)"
+                                 R"("rtr":{"type":"boolean"},"error":{"type":"boolean"},"data":)" + kBytes),
+      object("foxglove.RawImage", R"("frame_id":{"type":"string"},"width":{"type":"integer"},"height":{"type":"integer"},)"
+                                  R"("encoding":{"type":"string"},"step":{"type":"integer"},"sequence":{"type":"integer"},"data":)" + kBytes),
+      object("foxglove.CompressedImage", R"("frame_id":{"type":"string"},"format":{"type":"string"},"width":{"type":"integer"},)"
+                                         R"("height":{"type":"integer"},"sequence":{"type":"integer"},"data":)" + kBytes),
+      object("foxglove.LaserScan", R"("frame_id":{"type":"string"},)" + pose() + R"(,"start_angle":{"type":"number"},)"
+                                   R"("end_angle":{"type":"number"},"ranges":)" + kNumberArray + R"(,"intensities":)" + kNumberArray +
+                                   R"(,"sequence":{"type":"integer"},"beam_duration":{"type":"number"},"status":{"type":"integer"})"),
+      object("fusedet.TiltSample", R"("angle":{"type":"number"},"velocity":{"type":"number"})"),
+      object("foxglove.PointCloud", R"("frame_id":{"type":"string"},)" + pose() + R"(,"point_stride":{"type":"integer"},)"
+                                    R"("fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},)"
+                                    R"("offset":{"type":"integer"},"type":{"type":"integer"}}}},"data":)" + kBytes),
+      R"({"title":"foxglove.ImageAnnotations","type":"object","properties":{"circles":{"type":"array"},)"
+      R"("points":{"type":"array","items":{"type":"object","properties":{)" + std::string(kTimeProp) +
+          R"(,"type":{"type":"integer"},"points":{"type":"array","items":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"}}}},)"
+          R"("outline_color":{"type":"object"},"thickness":{"type":"number"}}}},)"
+          R"("texts":{"type":"array","items":{"type":"object","properties":{)" + std::string(kTimeProp) +
+          R"(,"position":{"type":"object"},"text":{"type":"string"},"font_size":{"type":"number"}}}}}})",
+      std::string(R"({"title":"foxglove.FrameTransform","type":"object","properties":{)") + kTimeProp +
+          R"(,"parent_frame_id":{"type":"string"},"child_frame_id":{"type":"string"},"translation":)" + kVec3 +
+          R"(,"rotation":)" + kQuat + "}}",
+  };
+  return texts[static_cast<int>(s)];
+}
+
+json timestamp(Stamp s) {
+  const std::int64_t sec = s.ns >= 0 ? s.ns / 1'000'000'000 : -((-s.ns + 999'999'999) / 1'000'000'000);
+  return json{{"sec", sec}, {"nsec", s.ns - sec * 1'000'000'000}};
+}
+
+std::vector<std::uint8_t> bytesOf(const json& j) {
+  const std::string s = j.dump();
+  return {s.begin(), s.end()};
+}
+
+Error bad(const std::string& what) { return makeError(std::errc::bad_message, what); }
+
+// Parses a message; every accessor below throws json exceptions that decode() turns into errors.
+template <class T, class F>
+Result<T> decode(std::span<const std::uint8_t> bytes, const char* what, F&& f) {
+  const json j = json::parse(bytes.begin(), bytes.end(), nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return bad(std::string(what) + ": not a JSON object");
+  try {
+    return f(j);
+  } catch (const json::exception& e) {
+    return bad(std::string(what) + ": " + e.what());
+  } catch (const std::invalid_argument& e) {
+    return bad(std::string(what) + ": " + e.what());
+  }
+}
+
+Stamp stampOf(const json& j) {
+  const json& t = j.at("timestamp");
+  return Stamp{t.at("sec").get<std::int64_t>() * 1'000'000'000 + t.at("nsec").get<std::int64_t>()};
+}
+
+std::vector<std::uint8_t> dataOf(const json& j) {
+  auto d = base64Decode(j.at("data").get<std::string>());
+  if (!d) throw std::invalid_argument("field 'data' is not base64");
+  return std::move(*d);
+}
+
+json identityPose() {
+  return json{{"position", {{"x", 0}, {"y", 0}, {"z", 0}}}, {"orientation", {{"x", 0}, {"y", 0}, {"z", 0}, {"w", 1}}}};
+}
+
+// foxglove.LaserScan bearings count from +x (ahead); LaserScan angles from the right (0 = right).
+constexpr double kBearingOffset = M_PI / 2;
+
+}  // namespace
+
+std::string_view schemaName(Schema s) {
+  static constexpr std::string_view names[] = {"fusedet.RawSerial", "fusedet.CanFrame", "foxglove.RawImage",
+                                               "foxglove.CompressedImage", "foxglove.LaserScan", "fusedet.TiltSample",
+                                               "foxglove.PointCloud", "foxglove.ImageAnnotations", "foxglove.FrameTransform"};
+  return names[static_cast<int>(s)];
+}
+std::string_view schemaJson(Schema s) { return schemaText(s); }
+std::optional<Schema> schemaByName(std::string_view name) {
+  for (Schema s : kAllSchemas)
+    if (schemaName(s) == name) return s;
+  return std::nullopt;
+}
+
+std::vector<std::uint8_t> encode(const SerialChunk& m) {
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"device", m.device}, {"baud", m.baud}, {"data", base64Encode(m.bytes)}});
+}
+
+std::vector<std::uint8_t> encode(const CanMessage& m) {
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"interface", m.interface}, {"id", m.id}, {"extended", m.extended},
+                      {"rtr", m.rtr}, {"error", m.error}, {"data", base64Encode(m.data)}});
+}
+
+Schema schemaOf(const CameraFrame& m) { return m.format == PixelFormat::kMjpeg ? Schema::kCompressedImage : Schema::kRawImage; }
+
+namespace {
+std::string_view encodingOf(PixelFormat f) {
+  switch (f) {
+    case PixelFormat::kBgr24: return "bgr8";
+    case PixelFormat::kGray8: return "mono8";
+    case PixelFormat::kYuyv: return "yuyv";
+    case PixelFormat::kMjpeg: return "jpeg";
+  }
+  return "";
+}
+}  // namespace
+
+std::vector<std::uint8_t> encode(const CameraFrame& m) {
+  json j{{"timestamp", timestamp(m.stamp)}, {"frame_id", "camera"}, {"sequence", m.sequence}, {"width", m.width},
+         {"height", m.height}, {"data", base64Encode(m.bytes)}};
+  if (m.format == PixelFormat::kMjpeg) {
+    j["format"] = "jpeg";
+  } else {
+    j["encoding"] = encodingOf(m.format);
+    j["step"] = m.stride;
+  }
+  return bytesOf(j);
+}
+
+std::vector<std::uint8_t> encode(const LaserScan& m) {
+  const double last = m.ranges.empty() ? m.startAngle : m.beamAngle(m.size() - 1);
+  json j{{"timestamp", timestamp(m.stamp)}, {"frame_id", "laser"}, {"pose", identityPose()},
+         {"start_angle", m.startAngle - kBearingOffset}, {"end_angle", last - kBearingOffset}, {"ranges", m.ranges},
+         {"intensities", m.remissions}, {"sequence", m.sequence}, {"beam_duration", m.beamDuration}, {"status", m.status}};
+  return bytesOf(j);
+}
+
+std::vector<std::uint8_t> encode(const TiltSample& m) {
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"angle", m.angle}, {"velocity", m.velocity}});
+}
+
+std::vector<std::uint8_t> encode(const PointCloudMessage& m) {
+  std::vector<std::uint8_t> data(m.points.size() * 16);
+  if (!m.points.empty()) std::memcpy(data.data(), m.points.data(), data.size());
+  constexpr int kFloat32 = 7;  // foxglove.NumericType FLOAT32
+  json fields = json::array();
+  const char* names[] = {"x", "y", "z", "remission"};
+  for (int i = 0; i < 4; ++i) fields.push_back({{"name", names[i]}, {"offset", 4 * i}, {"type", kFloat32}});
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"frame_id", m.frame}, {"pose", identityPose()},
+                      {"point_stride", 16}, {"fields", fields}, {"data", base64Encode(data)}});
+}
+
+std::vector<std::uint8_t> encode(const AnnotationsMessage& m) {
+  json points = json::array(), texts = json::array();
+  const json colour{{"r", 1.0}, {"g", 0.8}, {"b", 0.0}, {"a", 1.0}};
+  for (const Annotation& a : m.boxes) {
+    constexpr int kLineLoop = 2;  // foxglove.PointsAnnotationType LINE_LOOP
+    points.push_back({{"timestamp", timestamp(m.stamp)}, {"type", kLineLoop},
+                      {"points", json::array({{{"x", a.x}, {"y", a.y}}, {{"x", a.x + a.width}, {"y", a.y}},
+                                              {{"x", a.x + a.width}, {"y", a.y + a.height}}, {{"x", a.x}, {"y", a.y + a.height}}})},
+                      {"outline_color", colour}, {"thickness", 2.0}});
+    char text[96];
+    std::snprintf(text, sizeof text, "%s %.2f", a.label.c_str(), a.score);
+    texts.push_back({{"timestamp", timestamp(m.stamp)}, {"position", {{"x", a.x}, {"y", a.y}}}, {"text", text},
+                     {"font_size", 14.0}, {"text_color", colour}, {"background_color", {{"r", 0}, {"g", 0}, {"b", 0}, {"a", 0.6}}}});
+  }
+  return bytesOf(json{{"circles", json::array()}, {"points", points}, {"texts", texts}});
+}
+
+std::vector<std::uint8_t> encode(const TransformMessage& m) {
+  const auto& t = m.translation;
+  const auto& q = m.rotation;
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"parent_frame_id", m.parent}, {"child_frame_id", m.child},
+                      {"translation", {{"x", t[0]}, {"y", t[1]}, {"z", t[2]}}},
+                      {"rotation", {{"x", q[0]}, {"y", q[1]}, {"z", q[2]}, {"w", q[3]}}}});
+}
+
+Result<SerialChunk> decodeSerial(std::span<const std::uint8_t> bytes) {
+  return decode<SerialChunk>(bytes, "fusedet.RawSerial", [](const json& j) {
+    return SerialChunk{stampOf(j), j.at("device").get<std::string>(), j.at("baud").get<int>(), dataOf(j)};
+  });
+}
+
+Result<CanMessage> decodeCan(std::span<const std::uint8_t> bytes) {
+  return decode<CanMessage>(bytes, "fusedet.CanFrame", [](const json& j) {
+    CanMessage m{stampOf(j), j.at("interface").get<std::string>(), j.at("id").get<std::uint32_t>(),
+                 j.at("extended").get<bool>(), j.at("rtr").get<bool>(), j.at("error").get<bool>(), dataOf(j)};
+    if (m.data.size() > 8) throw std::invalid_argument("CAN frame with " + std::to_string(m.data.size()) + " data bytes");
+    if (m.id > (m.extended ? 0x1FFFFFFFu : 0x7FFu)) throw std::invalid_argument("CAN id out of range");
+    return m;
+  });
+}
+
+Result<CameraFrame> decodeCamera(std::span<const std::uint8_t> bytes) {
+  return decode<CameraFrame>(bytes, "camera image", [](const json& j) {
+    CameraFrame f;
+    f.stamp = stampOf(j);
+    f.sequence = j.value("sequence", std::uint64_t{0});
+    f.width = j.at("width").get<int>();
+    f.height = j.at("height").get<int>();
+    if (j.contains("format")) {
+      if (j.at("format").get<std::string>() != "jpeg") throw std::invalid_argument("compressed format is not jpeg");
+      f.format = PixelFormat::kMjpeg;
+    } else {
+      const std::string e = j.at("encoding").get<std::string>();
+      if (e == "bgr8") f.format = PixelFormat::kBgr24;
+      else if (e == "mono8") f.format = PixelFormat::kGray8;
+      else if (e == "yuyv") f.format = PixelFormat::kYuyv;
+      else throw std::invalid_argument("unsupported encoding '" + e + "'");
+      f.stride = j.at("step").get<int>();
+    }
+    f.bytes = dataOf(j);
+    return f;
+  });
+}
+
+Result<LaserScan> decodeLaserScan(std::span<const std::uint8_t> bytes) {
+  return decode<LaserScan>(bytes, "foxglove.LaserScan", [](const json& j) {
+    LaserScan s;
+    s.stamp = stampOf(j);
+    s.ranges = j.at("ranges").get<std::vector<float>>();
+    s.remissions = j.value("intensities", std::vector<float>{});
+    s.startAngle = j.at("start_angle").get<double>() + kBearingOffset;
+    const double end = j.at("end_angle").get<double>() + kBearingOffset;
+    s.angleStep = s.ranges.size() > 1 ? (end - s.startAngle) / static_cast<double>(s.ranges.size() - 1) : 0;
+    s.sequence = j.value("sequence", std::uint64_t{0});
+    s.beamDuration = j.value("beam_duration", 0.0);
+    s.status = j.value("status", std::uint8_t{0});
+    return s;
+  });
+}
+
+Result<TiltSample> decodeTilt(std::span<const std::uint8_t> bytes) {
+  return decode<TiltSample>(bytes, "fusedet.TiltSample", [](const json& j) {
+    return TiltSample{stampOf(j), j.at("angle").get<double>(), j.at("velocity").get<double>()};
+  });
+}
+
+Result<PointCloudMessage> decodePointCloud(std::span<const std::uint8_t> bytes) {
+  return decode<PointCloudMessage>(bytes, "foxglove.PointCloud", [](const json& j) {
+    PointCloudMessage m;
+    m.stamp = stampOf(j);
+    m.frame = j.at("frame_id").get<std::string>();
+    if (j.at("point_stride").get<int>() != 16) throw std::invalid_argument("point_stride is not 16 (x y z remission float32)");
+    const std::vector<std::uint8_t> d = dataOf(j);
+    if (d.size() % 16 != 0) throw std::invalid_argument("data is not a whole number of points");
+    m.points.resize(d.size() / 16);
+    if (!d.empty()) std::memcpy(m.points.data(), d.data(), d.size());
+    return m;
+  });
+}
+
+}  // namespace fusedet::drivers::logs

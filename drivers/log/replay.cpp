@@ -1,0 +1,149 @@
+#include "fusedet/drivers/log/replay.h"
+
+#include <thread>
+
+#include "fusedet/drivers/lms291/link.h"
+
+namespace fusedet::drivers::logs {
+
+LogSource::LogSource(const std::filesystem::path& log, ReplayOptions options)
+    : reader_(log), cursor_(reader_.messages()), options_(options) {}
+
+std::optional<LogRig> LogSource::rig() const {
+  const mcap::Metadata* m = reader_.index().findMetadata(kConfigMetadata);
+  if (!m) return std::nullopt;
+  LogRig rig;
+  rig.entries = m->entries;
+  if (auto it = m->entries.find(kConfigYamlKey); it != m->entries.end()) rig.configYaml = it->second;
+  if (auto it = m->entries.find(kCameraYamlKey); it != m->entries.end()) rig.cameraYaml = it->second;
+  return rig;
+}
+
+bool LogSource::waitUntilDue(std::uint64_t logTime, const std::atomic<bool>* stop) {
+  if (!firstLogTime_) {
+    firstLogTime_ = logTime;
+    wallStart_ = std::chrono::steady_clock::now();
+    if (options_.restamp) shiftNs_ = Stamp::now().ns - static_cast<std::int64_t>(logTime);
+  }
+  if (!options_.realtime) return !(stop && stop->load());
+  const double offsetS = static_cast<double>(logTime - *firstLogTime_) * 1e-9 / std::max(options_.speed, 1e-6);
+  const auto due = wallStart_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(offsetS));
+  // Sleep in short slices so a stop request is seen promptly.
+  for (;;) {
+    if (stop && stop->load()) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= due) return true;
+    std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(due - now, std::chrono::milliseconds(20)));
+  }
+}
+
+bool LogSource::step(const Handlers& h, const std::atomic<bool>* stop) {
+  const mcap::LogIndex& x = reader_.index();
+  for (;;) {
+    if (stop && stop->load()) return false;
+    std::optional<mcap::Message> m = cursor_.next();
+    if (!m) return false;
+    auto ch = x.channels.find(m->channelId);
+    const std::string topic = ch == x.channels.end() ? "" : ch->second.topic;
+    const bool serial = topic == topic::kLaserRaw, can = topic == topic::kCan,
+               camera = topic == topic::kCameraRaw || topic == topic::kCameraCompressed;
+    if (!serial && !can && !camera) {
+      ++counters_.otherMessages;
+      continue;
+    }
+    if (!waitUntilDue(m->logTime, stop)) return false;
+    ++counters_.messages;
+    if (serial) {
+      auto s = decodeSerial(m->data);
+      if (!s) {
+        ++counters_.undecodable;
+        continue;
+      }
+      s->stamp = s->stamp + shiftNs_;
+      ++counters_.serialChunks;
+      counters_.serialBytes += s->bytes.size();
+      if (h.serial) h.serial(*s);
+    } else if (can) {
+      auto c = decodeCan(m->data);
+      if (!c) {
+        ++counters_.undecodable;
+        continue;
+      }
+      c->stamp = c->stamp + shiftNs_;
+      ++counters_.canFrames;
+      if (h.can) h.can(*c);
+    } else {
+      auto f = decodeCamera(m->data);
+      if (!f) {
+        ++counters_.undecodable;
+        continue;
+      }
+      f->stamp = f->stamp + shiftNs_;
+      ++counters_.cameraFrames;
+      if (h.camera) h.camera(*f);
+    }
+    return true;
+  }
+}
+
+SensorReplay::SensorReplay(const std::filesystem::path& log, SensorReplayConfig config, ReplayOptions options)
+    : source_(log, options), config_(std::move(config)), tilt_(config_.tilt) {
+  const lms291::Lms291Config& l = config_.laser;
+  // What Lms291::start() sets the device to: the unit, and measuring mode 0x0D for range+remission.
+  scans_.reset(l.variant, l.remission, l.remission ? lms291::kMeasuringRemission : l.measuringMode, l.unit);
+}
+
+void SensorReplay::drainTelegrams(const Handlers& h, int baud) {
+  while (auto e = telegrams_.next()) {
+    if (e->kind != lms291::StreamEvent::Kind::kTelegram) continue;
+    if (auto scan = scans_.decode(e->telegram, baud); scan && h.scan) h.scan(*scan);
+  }
+}
+
+void SensorReplay::onSerial(const SerialChunk& chunk, const Handlers& h) {
+  if (chunk.baud != baud_) {  // the live link drops what was buffered at the old speed
+    telegrams_.clear();
+    telegrams_.setByteTime(static_cast<std::int64_t>(lms291::byteSeconds(std::max(chunk.baud, 1)) * 1e9));
+    baud_ = chunk.baud;
+  } else if (chunk.stamp - lastSerial_ >= std::chrono::duration_cast<std::chrono::nanoseconds>(lms291::silenceGap(baud_)).count()) {
+    telegrams_.expirePending();  // the line was silent as long as the live link waits
+    drainTelegrams(h, baud_);
+  }
+  lastSerial_ = chunk.stamp;
+  telegrams_.feed(chunk.bytes, chunk.stamp);
+  drainTelegrams(h, baud_);
+}
+
+bool SensorReplay::step(const Handlers& h, const std::atomic<bool>* stop) {
+  LogSource::Handlers raw;
+  raw.serial = [&](const SerialChunk& c) { onSerial(c, h); };
+  raw.can = [&](const CanMessage& c) {
+    if (auto s = tilt_.decode(c); s && h.tilt) h.tilt(*s);
+  };
+  raw.camera = [&](const CameraFrame& f) {
+    ++frames_;
+    if (h.frame) h.frame(f);
+  };
+  if (source_.step(raw, stop)) return true;
+  if (!(stop && stop->load()) && telegrams_.expirePending()) drainTelegrams(h, baud_);
+  return false;
+}
+
+void SensorReplay::run(const Handlers& handlers, const std::atomic<bool>* stop) {
+  while (step(handlers, stop)) {
+  }
+}
+
+SensorReplayCounters SensorReplay::counters() const {
+  SensorReplayCounters c;
+  c.raw = source_.counters();
+  c.telegrams = telegrams_.counters();
+  c.scans = scans_.scans();
+  c.lostScans = scans_.lostScans();
+  c.badScans = scans_.badScans();
+  c.tiltSamples = tilt_.counters().positions;
+  c.frames = frames_;
+  return c;
+}
+
+}  // namespace fusedet::drivers::logs

@@ -1,0 +1,48 @@
+#include "fusedet/drivers/log/tilt_decoder.h"
+
+#include <cmath>
+
+namespace fusedet::drivers::logs {
+
+double TiltDecoderConfig::countsToRad(std::int64_t counts) const {
+  return 2 * M_PI * static_cast<double>(counts - zeroOffsetCounts) / (countsPerRev * gearRatio);
+}
+
+std::int32_t TiltDecoderConfig::radToCounts(double rad) const {
+  return static_cast<std::int32_t>(std::lround(rad / (2 * M_PI) * countsPerRev * gearRatio) + zeroOffsetCounts);
+}
+
+std::optional<TiltSample> TiltDecoder::decode(const CanMessage& f) {
+  const auto node = static_cast<std::uint32_t>(config_.nodeId);
+  if (f.error || f.extended || f.rtr) {
+    ++counters_.other;
+    return std::nullopt;
+  }
+  if (f.id == 0x080) {
+    ++counters_.syncs;
+    return std::nullopt;
+  }
+  if (f.id == 0x700 + node) {
+    if (f.data.size() != 1) ++counters_.malformed;
+    else ++counters_.heartbeats, counters_.lastState = f.data[0];
+    return std::nullopt;
+  }
+  if (f.id != 0x180 + node) {
+    ++counters_.other;
+    return std::nullopt;
+  }
+  if (f.data.size() < 4) {
+    ++counters_.malformed;
+    return std::nullopt;
+  }
+  const auto raw = static_cast<std::int32_t>(static_cast<std::uint32_t>(f.data[0]) | (static_cast<std::uint32_t>(f.data[1]) << 8) |
+                                             (static_cast<std::uint32_t>(f.data[2]) << 16) |
+                                             (static_cast<std::uint32_t>(f.data[3]) << 24));
+  TiltSample s{f.stamp, config_.countsToRad(raw), 0.0};
+  if (last_ && s.stamp > last_->stamp) s.velocity = (s.angle - last_->angle) / ((s.stamp - last_->stamp) * 1e-9);
+  last_ = s;
+  ++counters_.positions;
+  return s;
+}
+
+}  // namespace fusedet::drivers::logs

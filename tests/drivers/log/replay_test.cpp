@@ -1,0 +1,249 @@
+// Replay: a log recorded from known telegrams, CAN frames and camera buffers comes back through
+// the live decoders with the values and stamps that went in; pacing, determinism, stop, and a
+// cut log replaying up to its last complete chunk.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "fusedet/drivers/lms291/protocol.h"
+#include "fusedet/drivers/lms291/telegram.h"
+#include "fusedet/drivers/log/recorder.h"
+#include "fusedet/drivers/log/replay.h"
+
+namespace fs = std::filesystem;
+using namespace fusedet;
+using namespace fusedet::drivers;
+using namespace fusedet::drivers::logs;
+
+namespace {
+
+constexpr std::int64_t kT0 = 2'000'000'000;
+constexpr int kBaud = 500000;
+constexpr int kScans = 30;
+
+// Range of beam b of scan s [mm]: easy to check, inside the 13-bit range.
+std::uint16_t rangeMm(int s, int b) { return static_cast<std::uint16_t>(1000 + 10 * s + b); }
+
+// A B0 telegram (180 deg / 1 deg, mm) of scan s, as the device sends it.
+std::vector<std::uint8_t> scanTelegram(int s) {
+  lms291::MeasuredValues v;
+  v.countWord.count = 181;
+  v.countWord.unit = lms291::Unit::kMm;
+  for (int b = 0; b < 181; ++b) v.values.push_back(rangeMm(s, b));
+  lms291::Telegram t;
+  t.address = 0x80;
+  t.command = lms291::kMeasuredValues;
+  t.data = lms291::encodeMeasuredValues(v);
+  t.status = 0x10;
+  return lms291::encode(t);
+}
+
+struct Sample {
+  fs::path path;
+  std::vector<std::int64_t> scanStarts;  // when each telegram's first byte went on the line
+};
+
+// 30 scans at 75 Hz, each telegram delivered in 64-byte reads stamped when their last byte
+// arrived; a garbage byte between scans; TPDOs at 100 Hz; 3 camera frames.
+Sample writeLog(const std::string& name, mcap::WriterOptions o = {}) {
+  Sample out;
+  out.path = fs::temp_directory_path() / ("fusedet_replay_" + std::to_string(::getpid()) + "_" + name);
+  Recorder rec(out.path, o, std::chrono::milliseconds(0));
+  rec.setRig("version: 1\n", "image_width: 2\n");
+  const std::int64_t byteNs = 20'000;  // 10 bits at 500 kbaud
+  for (int s = 0; s < kScans; ++s) {
+    const std::int64_t start = kT0 + s * 13'333'333;
+    out.scanStarts.push_back(start);
+    std::vector<std::uint8_t> bytes = scanTelegram(s);
+    if (s % 5 == 2) bytes.insert(bytes.begin(), 0x55), out.scanStarts.back() += byteNs;  // line noise first
+    for (std::size_t at = 0; at < bytes.size(); at += 64) {
+      const std::size_t n = std::min<std::size_t>(64, bytes.size() - at);
+      rec.record(SerialChunk{Stamp{start + static_cast<std::int64_t>(at + n) * byteNs}, "/dev/ttyUSB0", kBaud,
+                             {bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(at + n)}});
+    }
+  }
+  const TiltDecoderConfig tilt;
+  for (int i = 0; i < 40; ++i) {
+    rec.record(CanMessage{Stamp{kT0 + i * 10'000'000}, "can0", 0x080, false, false, false, {}});
+    const std::int32_t counts = tilt.radToCounts(0.01 * i);
+    const auto u = static_cast<std::uint32_t>(counts);
+    rec.record(CanMessage{Stamp{kT0 + i * 10'000'000 + 300'000}, "can0", 0x185, false, false, false,
+                          {static_cast<std::uint8_t>(u), static_cast<std::uint8_t>(u >> 8), static_cast<std::uint8_t>(u >> 16),
+                           static_cast<std::uint8_t>(u >> 24)}});
+  }
+  for (int i = 0; i < 3; ++i) {
+    CameraFrame f;
+    f.stamp = Stamp{kT0 + i * 100'000'000};
+    f.sequence = static_cast<std::uint64_t>(i);
+    f.width = 2;
+    f.height = 1;
+    f.stride = 4;
+    f.format = PixelFormat::kYuyv;
+    f.bytes = {16, 128, static_cast<std::uint8_t>(i), 128};
+    rec.record(f);
+  }
+  rec.record(TiltSample{Stamp{kT0}, 1, 0});  // a decoded channel: replay skips it
+  rec.close();
+  return out;
+}
+
+SensorReplayConfig rig() {
+  SensorReplayConfig c;
+  c.laser.variant = lms291::Variant{180, 100};
+  c.laser.remission = false;
+  return c;
+}
+
+struct Collected {
+  std::vector<LaserScan> scans;
+  std::vector<TiltSample> tilt;
+  std::vector<CameraFrame> frames;
+  std::vector<std::int64_t> order;  // stamps in delivery order
+};
+
+Collected replayAll(const fs::path& p, ReplayOptions o = {}, const std::atomic<bool>* stop = nullptr) {
+  Collected c;
+  SensorReplay r(p, rig(), o);
+  SensorReplay::Handlers h;
+  h.scan = [&](const LaserScan& s) { c.scans.push_back(s); };
+  h.tilt = [&](const TiltSample& t) { c.tilt.push_back(t), c.order.push_back(t.stamp.ns); };
+  h.frame = [&](const CameraFrame& f) { c.frames.push_back(f), c.order.push_back(f.stamp.ns); };
+  r.run(h, stop);
+  return c;
+}
+
+}  // namespace
+
+TEST(Replay, LiveDecodersGiveBackWhatWasRecorded) {
+  const Sample s = writeLog("decode.mcap");
+  SensorReplay r(s.path, rig());
+  Collected c;
+  SensorReplay::Handlers h;
+  h.scan = [&](const LaserScan& x) { c.scans.push_back(x); };
+  h.tilt = [&](const TiltSample& t) { c.tilt.push_back(t); };
+  h.frame = [&](const CameraFrame& f) { c.frames.push_back(f); };
+  r.run(h);
+  ASSERT_EQ(c.scans.size(), static_cast<std::size_t>(kScans));
+  for (int i = 0; i < kScans; ++i) {
+    const LaserScan& x = c.scans[static_cast<std::size_t>(i)];
+    ASSERT_EQ(x.size(), 181u);
+    EXPECT_NEAR(x.ranges[7], rangeMm(i, 7) * 1e-3, 1e-6);
+    EXPECT_EQ(x.stamp.ns, s.scanStarts[static_cast<std::size_t>(i)]) << "scan " << i;  // end of telegram - line time
+    EXPECT_EQ(x.sequence, static_cast<std::uint64_t>(i));
+    EXPECT_EQ(x.status, 0x10);
+    EXPECT_NEAR(x.startAngle, 0, 1e-12);
+  }
+  ASSERT_EQ(c.tilt.size(), 40u);
+  EXPECT_NEAR(c.tilt[25].angle, 0.25, 1e-3);  // counts quantise to 2 pi / 204800 rad
+  EXPECT_EQ(c.tilt[25].stamp.ns, kT0 + 25 * 10'000'000 + 300'000);
+  EXPECT_NEAR(c.tilt[25].velocity, 1.0, 0.05);
+  ASSERT_EQ(c.frames.size(), 3u);
+  EXPECT_EQ(c.frames[2].bytes[2], 2);
+  const SensorReplayCounters n = r.counters();
+  EXPECT_EQ(n.scans, static_cast<std::uint64_t>(kScans));
+  EXPECT_EQ(n.telegrams.crcErrors, 0u);
+  EXPECT_EQ(n.telegrams.skippedBytes, 6u);  // the six noise bytes
+  EXPECT_EQ(n.raw.otherMessages, 1u);
+  EXPECT_EQ(n.raw.cameraFrames, 3u);
+  ASSERT_TRUE(r.source().rig());
+  EXPECT_EQ(r.source().rig()->cameraYaml, "image_width: 2\n");
+}
+
+TEST(Replay, DeterministicAndInStampOrder) {
+  const Sample s = writeLog("determinism.mcap");
+  const Collected a = replayAll(s.path), b = replayAll(s.path);
+  ASSERT_EQ(a.order, b.order);
+  EXPECT_TRUE(std::is_sorted(a.order.begin(), a.order.end()));
+  ASSERT_EQ(a.scans.size(), b.scans.size());
+  for (std::size_t i = 0; i < a.scans.size(); ++i) {
+    EXPECT_EQ(a.scans[i].stamp, b.scans[i].stamp);
+    EXPECT_EQ(a.scans[i].ranges, b.scans[i].ranges);
+  }
+}
+
+TEST(Replay, RealtimePacingAndStop) {
+  const Sample s = writeLog("pacing.mcap");  // 0.39 s of data
+  ReplayOptions o;
+  o.realtime = true;
+  auto t0 = std::chrono::steady_clock::now();
+  const Collected paced = replayAll(s.path, o);
+  const double pacedS = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_GE(pacedS, 0.38);  // never early; lateness under load is allowed
+  EXPECT_EQ(paced.scans.size(), static_cast<std::size_t>(kScans));
+  o.speed = 4;
+  t0 = std::chrono::steady_clock::now();
+  replayAll(s.path, o);
+  EXPECT_GE(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.095);
+  std::atomic<bool> stop{true};
+  EXPECT_TRUE(replayAll(s.path, o, &stop).scans.empty());
+}
+
+TEST(Replay, RestampShiftsEverythingByOneOffset) {
+  const Sample s = writeLog("restamp.mcap");
+  ReplayOptions o;
+  o.restamp = true;
+  const Collected a = replayAll(s.path), b = replayAll(s.path, o);
+  ASSERT_EQ(a.scans.size(), b.scans.size());
+  const std::int64_t shift = b.scans[0].stamp - a.scans[0].stamp;
+  EXPECT_GT(b.scans[0].stamp.ns, Stamp::now().ns - 60'000'000'000);
+  for (std::size_t i = 0; i < a.scans.size(); ++i) EXPECT_EQ(b.scans[i].stamp - a.scans[i].stamp, shift);
+}
+
+TEST(Replay, CutLogReplaysItsCompleteChunks) {
+  mcap::WriterOptions o;
+  o.chunkBytes = 4096;
+  const Sample s = writeLog("cut.mcap", o);
+  const auto size = fs::file_size(s.path);
+  const Collected whole = replayAll(s.path);
+  fs::resize_file(s.path, size * 2 / 3);
+  SensorReplay r(s.path, rig());
+  ASSERT_TRUE(r.source().index().truncation.has_value());
+  std::size_t scans = 0;
+  SensorReplay::Handlers h;
+  h.scan = [&](const LaserScan& x) {
+    EXPECT_EQ(x.ranges, whole.scans[scans].ranges);  // a prefix of the whole log's scans
+    ++scans;
+  };
+  r.run(h);
+  EXPECT_GT(scans, 0u);
+  EXPECT_LT(scans, whole.scans.size());
+}
+
+TEST(Replay, MissingOrForeignFileIsAnError) {
+  EXPECT_THROW(LogSource("/nonexistent.mcap"), mcap::McapError);
+  const fs::path p = fs::temp_directory_path() / ("fusedet_replay_text_" + std::to_string(::getpid()));
+  std::ofstream(p) << "not a log";
+  EXPECT_THROW(LogSource{p}, mcap::McapError);
+  fs::remove(p);
+}
+
+TEST(TiltDecoder, CountsUnitsAndBadFrames) {
+  TiltDecoderConfig c;
+  c.nodeId = 3;
+  c.countsPerRev = 1000;
+  c.gearRatio = 2;
+  c.zeroOffsetCounts = 100;
+  TiltDecoder d(c);
+  // 600 counts: (600 - 100) / 2000 rev = pi/2 rad
+  auto s = d.decode(CanMessage{Stamp{5}, "can0", 0x183, false, false, false, {0x58, 0x02, 0, 0}});
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->angle, M_PI / 2, 1e-12);
+  // negative counts (two's complement): -400 -> -pi/2
+  s = d.decode(CanMessage{Stamp{1'000'000'005}, "can0", 0x183, false, false, false, {0x70, 0xFE, 0xFF, 0xFF}});
+  ASSERT_TRUE(s);
+  EXPECT_NEAR(s->angle, -M_PI / 2, 1e-12);
+  EXPECT_NEAR(s->velocity, -M_PI, 1e-9);
+  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x183, false, false, false, {1, 2}}));      // short
+  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x185, false, false, false, {1, 2, 3, 4}}));  // other node
+  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x703, false, false, false, {0x05}}));
+  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x080, false, false, false, {}}));
+  EXPECT_EQ(d.counters().positions, 2u);
+  EXPECT_EQ(d.counters().malformed, 1u);
+  EXPECT_EQ(d.counters().heartbeats, 1u);
+  EXPECT_EQ(d.counters().lastState, 0x05);
+  EXPECT_EQ(d.counters().syncs, 1u);
+  EXPECT_EQ(c.radToCounts(M_PI / 2), 600);
+}
