@@ -125,10 +125,10 @@ Result<void> SocketCanBus::send(const CanFrame& frame) {
       if (!ready) return ready.error();
       continue;
     }
-    ++counters_.txFailures;
+    count(&CanBusCounters::txFailures);
     return socketError(e, "send", interface_);
   }
-  ++counters_.framesTx;
+  count(&CanBusCounters::framesTx);
   CanFrame sent = frame;
   sent.stamp = Stamp::now();
   notify(sent, FrameDirection::kTx);
@@ -153,7 +153,7 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::microseconds timeout) {
       auto ready = waitFor(fd_.get(), POLLIN, timeout);
       if (!ready) return socketError(ENODEV, "receive", interface_);
       if (!*ready) {
-        ++counters_.timeouts;
+        count(&CanBusCounters::timeouts);
         return makeError(std::errc::timed_out, "receive on " + interface_);
       }
       timeout = std::chrono::microseconds(0);  // data is there now; a second EAGAIN ends the call
@@ -175,12 +175,17 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::microseconds timeout) {
     }
     f.kernelStamp = realNs != 0;
     f.stamp = f.kernelStamp ? realtimeToMonotonic(realNs) : Stamp::now();
-    if (!f.kernelStamp) ++counters_.userStamps;
-    ++counters_.framesRx;
-    if (f.error) ++counters_.errorFrames;
+    if (!f.kernelStamp) count(&CanBusCounters::userStamps);
+    count(&CanBusCounters::framesRx);
+    if (f.error) count(&CanBusCounters::errorFrames);
     notify(f, FrameDirection::kRx);
     return f;
   }
+}
+
+CanBusCounters SocketCanBus::counters() const {
+  std::lock_guard lock(countersMutex_);
+  return counters_;
 }
 
 Result<void> SocketCanBus::setFilters(const std::vector<CanFilter>& filters) {

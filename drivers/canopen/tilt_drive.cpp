@@ -391,7 +391,13 @@ void TiltDrive::poll(Stamp now) {
   std::lock_guard lock(mutex_);
   now_ = now;
   if (startRequested_) {
+    // (Re)start from scratch, e.g. after the caller reopened a failed bus: drop what was pending.
     startRequested_ = false;
+    ++generation_;
+    sdo_.cancelAll(makeError(std::errc::operation_canceled, "restart"));
+    recovering_ = false;
+    move_ = MoveStep::kNone;
+    positioned_ = false;
     setFilters();
     phase_ = TiltPhase::kBooting;
     startedAt_ = now;

@@ -269,3 +269,19 @@ TEST(TiltDrive, HoldsAnAngleAndStops) {
   EXPECT_EQ(rig.motor.driveState(), DriveState::kReadyToSwitchOn);
   EXPECT_EQ(rig.motor.nmtState(), NmtState::kPreOperational);
 }
+
+TEST(TiltDrive, StartAgainRestartsFromScratch) {
+  // What a daemon does after reopening a failed bus: start() again mid-sweep.
+  Rig rig;
+  ASSERT_TRUE(rig.startUp());
+  ASSERT_TRUE(rig.sweepsDone(1, 30s));
+  rig.net.advance(1s);
+  rig.drive.start();
+  rig.net.advance(5ms);
+  EXPECT_FALSE(rig.drive.running());  // reset node sent, waiting for the boot-up
+  ASSERT_TRUE(rig.net.runUntil([&] { return rig.drive.running(); }, 5s));
+  EXPECT_EQ(rig.drive.counters().bootUps, 2u);
+  EXPECT_EQ(rig.drive.counters().faults, 0u);  // a requested restart is no fault
+  const auto sweeps = rig.drive.counters().sweeps;
+  EXPECT_TRUE(rig.sweepsDone(sweeps + 1, 30s));
+}

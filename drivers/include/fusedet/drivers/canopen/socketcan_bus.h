@@ -5,6 +5,7 @@
 // Stamps are the kernel's receive time (SO_TIMESTAMPING software stamps, else SIOCGSTAMP),
 // moved from CLOCK_REALTIME to CLOCK_MONOTONIC at reception.
 
+#include <mutex>
 #include <string>
 
 #include "fusedet/drivers/canopen/can_bus.h"
@@ -27,14 +28,19 @@ class SocketCanBus : public CanBus {
   Result<void> send(const CanFrame& frame) override;
   Result<CanFrame> receive(std::chrono::microseconds timeout) override;
   Result<void> setFilters(const std::vector<CanFilter>& filters) override;
-  CanBusCounters counters() const override { return counters_; }
+  CanBusCounters counters() const override;  // safe from any thread (daemon status)
   std::string name() const override { return interface_; }
 
  private:
   UniqueFd fd_;
   std::string interface_;
   bool timestamping_ = false;
+  mutable std::mutex countersMutex_;
   CanBusCounters counters_;
+  void count(std::uint64_t CanBusCounters::*field) {
+    std::lock_guard lock(countersMutex_);
+    ++(counters_.*field);
+  }
 };
 
 // Conversions between CanFrame and the kernel's struct can_frame (unit-tested without a socket).

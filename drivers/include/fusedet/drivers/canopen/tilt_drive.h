@@ -92,6 +92,8 @@ class TiltDrive : public CanNode {
   void setEventHandler(EventHandler h);
 
   // Bring the drive up (reset node first) and then nod; hold(angle) instead holds one angle.
+  // Calling start() again restarts from scratch (after runNode() returned a bus failure: reopen
+  // the same SocketCanBus object, start(), run again).
   void start();
   void nod();
   void hold(double angleRad);
