@@ -402,8 +402,10 @@ TEST_F(LmsSim, StopDuringASlowInitIsPrompt) {
   (void)stream.stop();
   const double took = std::chrono::duration<double>(Clock::now() - t0).count();
   // The init is cut short at once; the stop sequence (streaming off, 9600) then gives up on the
-  // silent device after one retry of 100 ms each (a full init could take ~10 s).
-  EXPECT_LT(took, 1.0) << "stop() waited for the init";
+  // silent device after one retry of 100 ms each (a full init could take ~10 s). About 0.3 s on
+  // a quiet machine; the bound leaves room for a loaded CI runner (1.08 s seen at load 20) while
+  // still telling "cut short" from "waited for the init".
+  EXPECT_LT(took, 2.5) << "stop() waited for the init";
   EXPECT_EQ(stream.state(), StreamState::kStopped);
 }
 
