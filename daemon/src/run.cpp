@@ -13,6 +13,7 @@
 #include "fusedet/daemon/camera_source.h"
 #include "fusedet/daemon/lms291_source.h"
 #include "fusedet/daemon/server.h"
+#include "fusedet/daemon/tilt_source.h"
 #include "fusedet/daemon/service.h"
 
 namespace fusedet::daemon {
@@ -46,6 +47,7 @@ ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
   parts.fuser = fuserFrom(config, configFile);
   parts.detector = detectorFrom(config, configFile);
   parts.sources.push_back(std::make_unique<Lms291Source>(config.laser));
+  parts.sources.push_back(std::make_unique<TiltSource>(config.tilt));
   parts.sources.push_back(std::make_unique<CameraSource>(config.camera));
   parts.configFile = configFile;
   parts.config = std::move(config);

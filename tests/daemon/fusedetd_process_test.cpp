@@ -43,7 +43,7 @@ void writeConfig(const fs::path& file, const std::string& socket, const std::vec
                  const std::string& extra = "") {
   std::ofstream out(file);
   out << "socket:\n  path: " << socket << "\nlaser:\n  device: /nonexistent/fusedet-test-ttyUSB\n"
-      << "  reconnect_max_s: 0.5\ncamera:\n  device: /nonexistent/fusedet-test-video\n  calibration: " << FUSEDET_SOURCE_DIR
+      << "  reconnect_max_s: 0.5\ntilt:\n  interface: fdtestcan9\ncamera:\n  device: /nonexistent/fusedet-test-video\n  calibration: " << FUSEDET_SOURCE_DIR
       << "/tests/daemon/data/camera.yaml\ndetection:\n  models: [";
   for (std::size_t i = 0; i < classes.size(); ++i) out << (i ? ", " : "") << model(classes[i]);
   out << "]\n" << extra;

@@ -1,0 +1,106 @@
+#include "fusedet/daemon/tilt_source.h"
+
+#include <spdlog/spdlog.h>
+
+#include "fusedet/drivers/canopen/can_node.h"
+#include "fusedet/drivers/canopen/socketcan_bus.h"
+
+namespace fusedet::daemon {
+
+drivers::canopen::TiltDriveConfig tiltDriveConfigFrom(const Config::Tilt& t) {
+  drivers::canopen::TiltDriveConfig c;
+  c.node = t.nodeId;
+  c.minDeg = t.minDeg;
+  c.maxDeg = t.maxDeg;
+  c.speedDegS = t.speedDegS;
+  c.units = {t.countsPerRev, t.gearRatio, static_cast<std::int32_t>(t.zeroOffsetCounts)};
+  c.heartbeatMs = t.heartbeatMs;
+  return c;
+}
+
+TiltSource::TiltSource(const Config::Tilt& tilt) : interface_(tilt.interface), config_(tiltDriveConfigFrom(tilt)) {
+  if (const std::string why = config_.validate(); !why.empty()) throw std::runtime_error("tilt: " + why);
+}
+
+TiltSource::~TiltSource() { stop(); }
+
+void TiltSource::start(SensorSink& sink) {
+  thread_ = std::thread([this, &sink] { run(sink); });
+}
+
+void TiltSource::stop() {
+  stop_ = true;
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void TiltSource::run(SensorSink& sink) {
+  auto setState = [this](const std::string& s, const std::string& error = {}) {
+    std::lock_guard lock(mutex_);
+    state_ = s;
+    if (!error.empty()) lastError_ = error;
+  };
+  while (!stop_) {
+    setState("connecting");
+    drivers::canopen::SocketCanBus bus;
+    if (auto opened = bus.open(interface_); !opened) {
+      setState("backing off", opened.error().message());
+    } else {
+      {
+        std::lock_guard lock(mutex_);
+        if (opens_++) ++reconnects_;
+      }
+      drivers::canopen::TiltDrive drive(bus, config_, [&sink](const drivers::TiltSample& s) { sink.onTilt(s); });
+      drive.nod();
+      drive.start();
+      setState("streaming");
+      // Copies the drive's counters for `status` while it runs (its callbacks must not call it).
+      std::atomic<bool> runnerDone{false};
+      std::thread watcher([&] {
+        while (!runnerDone && !stop_) {
+          {
+            std::lock_guard lock(mutex_);
+            counters_ = drive.counters();
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        }
+      });
+      std::atomic<bool> runnerStop{false};
+      std::thread runner([&] {
+        auto r = drivers::canopen::runNode(bus, drive, runnerStop);
+        if (!r) setState("backing off", r.error().message());
+        runnerDone = true;
+      });
+      while (!stop_ && !runnerDone) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (!runnerDone) {
+        // Stopping: bring the motor to rest (the drive needs the runner for that), then end.
+        drive.stop();
+        for (int i = 0; i < 100 && !drive.stopped() && !runnerDone; ++i)
+          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+      }
+      runnerStop = true;
+      runner.join();
+      watcher.join();
+      std::lock_guard lock(mutex_);
+      counters_ = drive.counters();
+    }
+    std::unique_lock lock(mutex_);
+    wake_.wait_for(lock, std::chrono::seconds(1), [this] { return stop_.load(); });
+  }
+  setState("stopped");
+}
+
+std::vector<SensorHealth> TiltSource::health() const {
+  std::lock_guard lock(mutex_);
+  SensorHealth h;
+  h.name = "tilt";
+  h.state = state_;
+  if (state_ == "streaming") h.state += std::string(" (") + std::string(drivers::canopen::toString(counters_.phase)) + ")";
+  h.messages = counters_.samples;
+  h.reconnects = reconnects_ + counters_.recoveries;
+  h.lost = counters_.badPdos;
+  h.lastError = counters_.lastFault.empty() ? lastError_ : counters_.lastFault;
+  return {h};
+}
+
+}  // namespace fusedet::daemon
