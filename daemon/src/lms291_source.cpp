@@ -2,25 +2,19 @@
 
 #include <cmath>
 
+#include "fusedet/daemon/rig.h"
+
 namespace fusedet::daemon {
 
-drivers::lms291::Lms291Config lms291ConfigFrom(const Config::Laser& laser) {
-  drivers::lms291::Lms291Config c;
-  c.device = laser.device;
-  c.baud = laser.baud;
-  c.variant = {laser.angleDeg, static_cast<int>(std::lround(laser.resolutionDeg * 100))};
-  c.remission = laser.remission;
-  return c;
-}
-
-Lms291Source::Lms291Source(const Config::Laser& laser) : config_(laser) {}
+Lms291Source::Lms291Source(const Config& config)
+    : config_(laserConfig(config)), reconnectMaxS_(config.laser.reconnectMaxS) {}
 
 Lms291Source::~Lms291Source() { stop(); }
 
 void Lms291Source::start(SensorSink& sink) {
   stream_ = std::make_unique<drivers::lms291::ScanStream>(
-      lms291ConfigFrom(config_), [&sink](const drivers::LaserScan& scan) { sink.onScan(scan); },
-      std::chrono::milliseconds(std::lround(config_.reconnectMaxS * 1000)));
+      config_, [&sink](const drivers::LaserScan& scan) { sink.onScan(scan); },
+      std::chrono::milliseconds(std::lround(reconnectMaxS_ * 1000)));
   stream_->start();
 }
 

@@ -46,7 +46,7 @@ ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
   ServiceParts parts;
   parts.fuser = fuserFrom(config, configFile);
   parts.detector = detectorFrom(config, configFile);
-  parts.sources.push_back(std::make_unique<Lms291Source>(config.laser));
+  parts.sources.push_back(std::make_unique<Lms291Source>(config));
   parts.sources.push_back(std::make_unique<TiltSource>(config.tilt));
   parts.sources.push_back(std::make_unique<CameraSource>(config.camera));
   parts.configFile = configFile;

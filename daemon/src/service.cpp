@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "fusedet/daemon/protocol.h"
+#include "fusedet/daemon/rig.h"
 #include "fusedet/fusion/camera_model.h"
 
 namespace fusedet::daemon {
@@ -17,15 +18,7 @@ std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::
   projection.laserLayerScale = config.fusion.laserLayerScale;
   projection.holeFillRadius = config.fusion.holeFillRadius;
   return std::make_shared<const fusion::Fuser>(
-      camera, fusion::rigidFromRpyDeg(config.fusion.rotationRpyDeg, config.fusion.translation), projection);
-}
-
-fusion::SweepConfig sweepConfigFrom(const Config& config) {
-  fusion::SweepConfig s;
-  s.tiltAxisOffset = Eigen::Vector3d(config.fusion.tiltAxisOffset[0], config.fusion.tiltAxisOffset[1],
-                                     config.fusion.tiltAxisOffset[2]);
-  s.tiltWindowS = config.fusion.tiltWindowMs * 1e-3;
-  return s;
+      camera, laserToCamera(config), projection);
 }
 
 ServerLimits serverLimitsFrom(const Config& config) {
@@ -49,7 +42,7 @@ Service::Service(ServiceParts parts)
   server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
   PipelineSetup setup;
   setup.fuser = std::move(parts.fuser);
-  setup.sweep = sweepConfigFrom(config_);
+  setup.sweep = sweepConfig(config_);
   setup.maxPairSkewNs = std::int64_t{config_.fusion.maxPairSkewMs} * 1'000'000;
   pipeline_ = std::make_unique<Pipeline>(std::move(setup), std::move(parts.detector),
                                          [this](std::shared_ptr<const StackResult> r) { server_->publish(std::move(r)); });

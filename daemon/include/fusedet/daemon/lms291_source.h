@@ -10,19 +10,17 @@
 
 namespace fusedet::daemon {
 
-// The driver's configuration from the config's laser section.
-drivers::lms291::Lms291Config lms291ConfigFrom(const Config::Laser& laser);
-
 class Lms291Source : public Source {
  public:
-  explicit Lms291Source(const Config::Laser& laser);
+  explicit Lms291Source(const Config& config);  // laser section, via rig.h's laserConfig
   ~Lms291Source() override;
   void start(SensorSink& sink) override;
   void stop() override;
   std::vector<SensorHealth> health() const override;
 
  private:
-  Config::Laser config_;
+  drivers::lms291::Lms291Config config_;
+  double reconnectMaxS_;
   std::unique_ptr<drivers::lms291::ScanStream> stream_;
 };
 

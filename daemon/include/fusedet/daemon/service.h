@@ -34,7 +34,6 @@ struct ServiceParts {
 // calibration path is relative to the config file's folder. Throws std::runtime_error naming the
 // calibration file on failure.
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile);
-fusion::SweepConfig sweepConfigFrom(const Config& config);
 ServerLimits serverLimitsFrom(const Config& config);
 // Models resolve relative to the config file's folder.
 std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
