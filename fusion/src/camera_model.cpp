@@ -130,4 +130,16 @@ Eigen::Isometry3d rigidFromRpyDeg(const std::array<double, 3>& rpyDeg, const std
   return T;
 }
 
+std::array<double, 3> rpyDegFromRotation(const Eigen::Matrix3d& R) {
+  constexpr double kRad = 180.0 / M_PI;
+  // R = Rz(y) Ry(p) Rx(r): R(2,0) = -sin p, R(2,1) = cos p sin r, R(2,2) = cos p cos r,
+  // R(1,0) = sin y cos p, R(0,0) = cos y cos p.
+  const double cosPitch = std::hypot(R(0, 0), R(1, 0));
+  const double pitch = std::atan2(-R(2, 0), cosPitch);
+  if (cosPitch < 1e-12) {  // gimbal lock: R(0,1) = -sin(y -+ r), R(1,1) = cos(y -+ r)
+    return {0.0, pitch * kRad, std::atan2(-R(0, 1), R(1, 1)) * kRad};
+  }
+  return {std::atan2(R(2, 1), R(2, 2)) * kRad, pitch * kRad, std::atan2(R(1, 0), R(0, 0)) * kRad};
+}
+
 }  // namespace fusedet::fusion

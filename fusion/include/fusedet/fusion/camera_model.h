@@ -34,5 +34,8 @@ CameraModel parseCameraModel(const std::string& yamlText, const std::string& wha
 // A rigid transform from roll/pitch/yaw in degrees applied as Rz(yaw) * Ry(pitch) * Rx(roll),
 // then the translation: p' = R p + t (the `fusion.laser_to_camera` config convention).
 Eigen::Isometry3d rigidFromRpyDeg(const std::array<double, 3>& rpyDeg, const std::array<double, 3>& translation);
+// The inverse: roll, pitch, yaw in degrees with pitch in [-90, 90], roll and yaw in (-180, 180].
+// At pitch +-90 (gimbal lock) only roll -+ yaw is defined; roll is then reported as 0.
+std::array<double, 3> rpyDegFromRotation(const Eigen::Matrix3d& R);
 
 }  // namespace fusedet::fusion
