@@ -84,6 +84,7 @@ int runCalibrate(const CalibrateOptions& o) {
   } else {
     std::printf("sigma     not estimated (needs 3 or more frames and no --no-uncertainty)\n");
   }
+  if (o.out.has_parent_path()) fs::create_directories(o.out.parent_path());
   fusion::writeLaserToCamera(o.out, r.laserToCamera, comment.str());
   std::printf("wrote     %s (%d cost evaluations)\n", o.out.c_str(), r.evaluations);
   if (!o.overlayDir.empty()) {
