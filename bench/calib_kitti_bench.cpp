@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
     opt.pyramidLevels = levels;
     opt.estimateUncertainty = false;  // the trials measure the error itself
     std::printf("\nmeasure %s\n", name.c_str());
-    std::printf("trial  start_deg  start_m  final_deg  final_m   wall_s   cpu_s  evals   final error: rotation vector [deg], translation [m] (camera axes)\n");
+    std::printf("trial  start_deg  start_m  final_deg  final_m   wall_s   cpu_s  evals   score   final error: rotation vector [deg], translation [m] (camera axes)\n");
     std::vector<double> startDeg, startM, finalDeg, finalM, wall, cpu;
     for (int t = 0; t < trials; ++t) {
       const auto w0 = std::chrono::steady_clock::now();
@@ -131,9 +131,10 @@ int main(int argc, char** argv) {
       const Eigen::Isometry3d e = r.laserToCamera * in.laserToCamera.inverse();
       const Eigen::AngleAxisd aa(e.linear());
       const Eigen::Vector3d w = aa.axis() * aa.angle() * 180.0 / M_PI, dt = e.translation();
-      std::printf("%5d  %9.3f  %7.3f  %9.3f  %7.3f  %7.1f  %6.1f  %5d   [%6.3f %6.3f %6.3f] [%6.3f %6.3f %6.3f]\n", t,
+      const double score = opt.measure == AlignmentMeasure::kMutualInformation ? r.after.mutualInformation : r.after.edgeAlignment;
+      std::printf("%5d  %9.3f  %7.3f  %9.3f  %7.3f  %7.1f  %6.1f  %5d  %6.4f  [%6.3f %6.3f %6.3f] [%6.3f %6.3f %6.3f]\n", t,
                   startDeg.back(), startM.back(), finalDeg.back(), finalM.back(), wall.back(), cpu.back(), r.evaluations,
-                  w.x(), w.y(), w.z(), dt.x(), dt.y(), dt.z());
+                  score, w.x(), w.y(), w.z(), dt.x(), dt.y(), dt.z());
       std::fflush(stdout);
     }
     const double mDeg = median(finalDeg), mM = median(finalM);
