@@ -402,6 +402,12 @@ cv::Mat eightBit(const Layer& l) {
 void setVectorScanEnabled(bool enabled) { gVectorEnabled = enabled; }
 bool vectorScanEnabled() { return gVectorEnabled.load(std::memory_order_relaxed); }
 
+namespace {
+std::atomic<int> gVectorLanesLimit{8};
+}  // namespace
+void setVectorLanesLimit(int lanes) { gVectorLanesLimit = lanes; }
+int vectorLanesLimit() { return gVectorLanesLimit.load(std::memory_order_relaxed); }
+
 void integrateCv(const cv::Mat& gray, bool tilted, CvIntegrals& out) {
   const int w = gray.cols, h = gray.rows;
   out.width = w;

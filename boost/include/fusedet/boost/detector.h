@@ -61,6 +61,12 @@ WindowResult evaluateWindow(const Cascade& cascade, const IntegralStack& integra
 // Layer names a cascade needs from a stack, and the integrals for them.
 IntegralStack integrateFor(const Cascade& cascade, const LayerStack& stack);
 
+// The widest vector path the one-pass scanner may use for our models: 8 windows per step
+// (AVX-512), 4 (AVX2) or 1 (scalar); the CPU decides below that. Process-wide; for tests and
+// benchmarks that compare the paths (all decide the same). setVectorScanEnabled(false)
+// (opencv_cascade.h) switches every vector path off.
+void setVectorLanesLimit(int lanes);
+
 class Detector {
  public:
   // Validates the cascade (throws std::invalid_argument naming its source and the problem).
