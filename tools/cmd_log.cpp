@@ -1,10 +1,15 @@
 // fusedet log: inspect and export MCAP sensor logs (docs/log-format.md).
-//   info LOG     channels, counts, time span, gaps, damage (where a cut file was cut)
+//   info LOG                          channels, counts, time span, gaps, damage (where a cut file was cut)
+//   export LOG --candump F | --png DIR | --ply DIR
 
 #include <cstdio>
 
 #include "command.h"
+#include "fusedet/daemon/config.h"
+#include "fusedet/daemon/rig.h"
+#include "fusedet/drivers/log/candump.h"
 #include "fusedet/drivers/log/log_info.h"
+#include "fusedet/fusion/log_export.h"
 
 namespace fusedet::tools {
 namespace {
@@ -12,6 +17,7 @@ namespace {
 struct LogOptions {
   std::string file;
   double gapFactor = 3.0;
+  std::string candump, png, ply;
 };
 
 int runInfo(const LogOptions& o) {
@@ -19,6 +25,25 @@ int runInfo(const LogOptions& o) {
   const drivers::logs::LogInfo info = drivers::logs::inspectLog(reader, o.gapFactor);
   std::fputs(drivers::logs::formatLogInfo(info, o.file).c_str(), stdout);
   return info.intact ? 0 : 3;
+}
+
+int runExport(const LogOptions& o) {
+  if (o.candump.empty() && o.png.empty() && o.ply.empty()) throw std::runtime_error("export: give --candump, --png or --ply");
+  if (!o.candump.empty())
+    std::printf("candump  %ju CAN frames -> %s\n", static_cast<std::uintmax_t>(drivers::logs::exportCandump(o.file, o.candump)),
+                o.candump.c_str());
+  if (!o.png.empty())
+    std::printf("png      %ju camera frames -> %s\n", static_cast<std::uintmax_t>(fusion::exportFramesPng(o.file, o.png)),
+                o.png.c_str());
+  if (!o.ply.empty()) {
+    // Sweeps are assembled with the rig the log carries (its fusedet.config), as replay does.
+    const auto rig = drivers::logs::LogSource(o.file).rig();
+    const daemon::Config config = rig ? daemon::parseConfig(rig->configYaml, o.file + ":fusedet.config") : daemon::Config{};
+    if (!rig) std::fprintf(stderr, "log: %s has no fusedet.config; assembling sweeps with the default rig\n", o.file.c_str());
+    const std::uint64_t n = fusion::exportSweepsPly(o.file, daemon::sensorReplayConfig(config), daemon::sweepConfig(config), o.ply);
+    std::printf("ply      %ju sweeps -> %s\n", static_cast<std::uintmax_t>(n), o.ply.c_str());
+  }
+  return 0;
 }
 
 const bool registered = registerCommand(
@@ -29,18 +54,29 @@ const bool registered = registerCommand(
       info->add_option("LOG", o->file, "an MCAP file")->required();
       info->add_option("--gap-factor", o->gapFactor, "an interval longer than this many median periods counts as a gap")
           ->capture_default_str();
+      CLI::App* exp = app.add_subcommand("export", "write a log's CAN frames, camera frames or sweeps in other tools' formats");
+      exp->add_option("LOG", o->file, "an MCAP file")->required();
+      exp->add_option("--candump", o->candump, "CAN frames as a can-utils `candump -l` log (log2asc, canplayer read it)");
+      exp->add_option("--png", o->png, "camera frames as DIR/frame_<sequence>_<stamp ns>.png");
+      exp->add_option("--ply", o->ply, "sweeps as DIR/sweep_<n>_<start ns>.ply (x y z remission, laser base frame)");
       app.footer(
           "info reads the whole file once, chunk by chunk, without trusting its summary: a file cut by a crash is\n"
           "read up to its last complete chunk and the report says where it was cut ('truncated cut at byte N inside\n"
           "a Chunk record starting at byte M ...'); chunks whose CRC or compression is damaged are skipped and\n"
           "listed as problems. Per channel: topic, schema, messages, span, mean rate, largest interval and the\n"
           "number of intervals longer than --gap-factor median periods.\n"
+          "export decodes camera frames as the live pipeline does (YUYV/MJPEG -> BGR) and takes the sweeps the log\n"
+          "recorded, or assembles them from its raw laser and CAN streams with the rig in its fusedet.config.\n"
+          "candump stamps are the log's CLOCK_MONOTONIC seconds.\n"
           "Examples:\n"
           "  fusedet log info run.mcap\n"
-          "Exit status: 0 for an intact file; 3 when it is truncated or damaged (the report still lists what is\n"
-          "readable); 1 on errors such as a missing file or one that is not MCAP ('fusedet log: error: ...').");
-      return [o, info]() -> int {
+          "  fusedet log export run.mcap --candump tilt.log && log2asc -I tilt.log -O tilt.asc can0\n"
+          "  fusedet log export run.mcap --png frames/ --ply sweeps/\n"
+          "Exit status: 0 for an intact file (info) or a finished export; 3 when info finds the file truncated or\n"
+          "damaged (the report still lists what is readable); 1 on errors ('fusedet log: error: ...').");
+      return [o, info, exp]() -> int {
         if (info->parsed()) return runInfo(*o);
+        if (exp->parsed()) return runExport(*o);
         return 2;
       };
     });

@@ -32,4 +32,25 @@ fusion::SweepConfig sweepConfig(const Config& c) {
 
 Eigen::Isometry3d laserToCamera(const Config& c) { return fusion::rigidFromRpyDeg(c.fusion.rotationRpyDeg, c.fusion.translation); }
 
+drivers::v4l2::CameraConfig cameraConfig(const Config& c) {
+  drivers::v4l2::CameraConfig v;
+  v.device = c.camera.device;
+  // The config loader accepted these values, so the parsers cannot fail here.
+  v.format = drivers::v4l2::parseFormatChoice(c.camera.format).value_or(drivers::v4l2::FormatChoice::kYuyv);
+  v.width = static_cast<std::uint32_t>(c.camera.width);
+  v.height = static_cast<std::uint32_t>(c.camera.height);
+  v.fps = c.camera.fps;
+  v.buffers = static_cast<std::uint32_t>(c.camera.buffers);
+  v.controls.exposure = drivers::v4l2::parseControlSetting(c.camera.exposure).value_or(drivers::v4l2::ControlSetting{});
+  v.controls.gain = drivers::v4l2::parseControlSetting(c.camera.gain).value_or(drivers::v4l2::ControlSetting{});
+  return v;
+}
+
+drivers::v4l2::FrameStreamTiming cameraTiming(const Config& c) {
+  drivers::v4l2::FrameStreamTiming t;
+  t.stallLimit = std::chrono::milliseconds(c.camera.stallMs);
+  t.reconnectMax = std::chrono::milliseconds(static_cast<long>(c.camera.reconnectMaxS * 1000));
+  return t;
+}
+
 }  // namespace fusedet::daemon

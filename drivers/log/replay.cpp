@@ -53,35 +53,27 @@ bool LogSource::step(const Handlers& h, const std::atomic<bool>* stop) {
     }
     if (!waitUntilDue(m->logTime, stop)) return false;
     ++counters_.messages;
+    // Decoded message -> restamped -> counted -> its handler; undecodable ones are skipped.
+    auto deliver = [&](auto decoded, std::uint64_t& count, const auto& handler) {
+      if (!decoded) return ++counters_.undecodable, false;
+      decoded->stamp = decoded->stamp + shiftNs_;
+      ++count;
+      if (handler) handler(*decoded);
+      return true;
+    };
+    bool ok;
     if (serial) {
-      auto s = decodeSerial(m->data);
-      if (!s) {
-        ++counters_.undecodable;
-        continue;
-      }
-      s->stamp = s->stamp + shiftNs_;
-      ++counters_.serialChunks;
-      counters_.serialBytes += s->bytes.size();
-      if (h.serial) h.serial(*s);
+      const std::function<void(const SerialChunk&)> countBytes = [&](const SerialChunk& c) {
+        counters_.serialBytes += c.bytes.size();
+        if (h.serial) h.serial(c);
+      };
+      ok = deliver(decodeSerial(m->data), counters_.serialChunks, countBytes);
     } else if (can) {
-      auto c = decodeCan(m->data);
-      if (!c) {
-        ++counters_.undecodable;
-        continue;
-      }
-      c->stamp = c->stamp + shiftNs_;
-      ++counters_.canFrames;
-      if (h.can) h.can(*c);
+      ok = deliver(decodeCan(m->data), counters_.canFrames, h.can);
     } else {
-      auto f = decodeCamera(m->data);
-      if (!f) {
-        ++counters_.undecodable;
-        continue;
-      }
-      f->stamp = f->stamp + shiftNs_;
-      ++counters_.cameraFrames;
-      if (h.camera) h.camera(*f);
+      ok = deliver(decodeCamera(m->data), counters_.cameraFrames, h.camera);
     }
+    if (!ok) continue;
     return true;
   }
 }

@@ -8,6 +8,7 @@
 #include "fusedet/daemon/config.h"
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/log/replay.h"
+#include "fusedet/drivers/v4l2/frame_stream.h"
 #include "fusedet/fusion/sweep_assembler.h"
 
 namespace fusedet::daemon {
@@ -17,5 +18,7 @@ drivers::logs::TiltDecoderConfig tiltUnits(const Config& c);         // tilt: no
 drivers::logs::SensorReplayConfig sensorReplayConfig(const Config& c);
 fusion::SweepConfig sweepConfig(const Config& c);                   // fusion: tilt axis offset, window; laser: remission scale
 Eigen::Isometry3d laserToCamera(const Config& c);                   // fusion.laser_to_camera
+drivers::v4l2::CameraConfig cameraConfig(const Config& c);          // camera: device, format, size, fps, buffers, controls
+drivers::v4l2::FrameStreamTiming cameraTiming(const Config& c);     // camera: stall_ms, reconnect_max_s
 
 }  // namespace fusedet::daemon
