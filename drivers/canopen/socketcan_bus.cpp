@@ -1,3 +1,4 @@
+#include <cstdint>
 #include "fusedet/drivers/canopen/socketcan_bus.h"
 
 #include <linux/can.h>
@@ -20,13 +21,23 @@ namespace {
 
 std::int64_t toNs(const timespec& t) { return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec; }
 
-// The kernel stamps in CLOCK_REALTIME; fusedet uses CLOCK_MONOTONIC. The offset is read now,
-// microseconds after reception, so an NTP step between the two is the only error source.
+// The kernel stamps in CLOCK_REALTIME; fusedet uses CLOCK_MONOTONIC. The offset is measured
+// now as real/mono/real, keeping the tightest of three readings: a thread preempted between two
+// clock reads (seen in the real-kernel tier under TCG) would otherwise shift the offset by the
+// preemption and put frames received microseconds apart out of order.
 Stamp realtimeToMonotonic(std::int64_t realNs) {
-  timespec mono{}, real{};
-  ::clock_gettime(CLOCK_MONOTONIC, &mono);
-  ::clock_gettime(CLOCK_REALTIME, &real);
-  return Stamp{realNs + (toNs(mono) - toNs(real))};
+  std::int64_t best = 0, width = INT64_MAX;
+  for (int i = 0; i < 3; ++i) {
+    timespec r1{}, mono{}, r2{};
+    ::clock_gettime(CLOCK_REALTIME, &r1);
+    ::clock_gettime(CLOCK_MONOTONIC, &mono);
+    ::clock_gettime(CLOCK_REALTIME, &r2);
+    if (toNs(r2) - toNs(r1) < width) {
+      width = toNs(r2) - toNs(r1);
+      best = toNs(mono) - (toNs(r1) + toNs(r2)) / 2;
+    }
+  }
+  return Stamp{realNs + best};
 }
 
 // Waits until fd is ready for `events`; false on timeout. EINTR restarts with the time left.
@@ -175,6 +186,9 @@ Result<CanFrame> SocketCanBus::receive(std::chrono::microseconds timeout) {
     }
     f.kernelStamp = realNs != 0;
     f.stamp = f.kernelStamp ? realtimeToMonotonic(realNs) : Stamp::now();
+    // Kernel stamps are in reception order: any residual offset error never reorders them.
+    if (f.stamp.ns < lastRxNs_) f.stamp = Stamp{lastRxNs_};
+    lastRxNs_ = f.stamp.ns;
     if (!f.kernelStamp) count(&CanBusCounters::userStamps);
     count(&CanBusCounters::framesRx);
     if (f.error) count(&CanBusCounters::errorFrames);

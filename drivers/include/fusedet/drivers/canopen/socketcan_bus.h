@@ -41,6 +41,7 @@ class SocketCanBus : public CanBus {
     std::lock_guard lock(countersMutex_);
     ++(counters_.*field);
   }
+  std::int64_t lastRxNs_ = 0;  // the previous received frame's stamp (kept non-decreasing)
 };
 
 // Conversions between CanFrame and the kernel's struct can_frame (unit-tested without a socket).
