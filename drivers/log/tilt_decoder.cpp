@@ -1,16 +1,16 @@
 #include "fusedet/drivers/log/tilt_decoder.h"
 
-#include <cmath>
 
 namespace fusedet::drivers::logs {
 
-double TiltDecoderConfig::countsToRad(std::int64_t counts) const {
-  return 2 * M_PI * static_cast<double>(counts - zeroOffsetCounts) / (countsPerRev * gearRatio);
+// The live drive's conversion (canopen::TiltUnits), so replay and live give the same angles.
+canopen::TiltUnits TiltDecoderConfig::units() const {
+  return canopen::TiltUnits{countsPerRev, gearRatio, static_cast<std::int32_t>(zeroOffsetCounts)};
 }
 
-std::int32_t TiltDecoderConfig::radToCounts(double rad) const {
-  return static_cast<std::int32_t>(std::lround(rad / (2 * M_PI) * countsPerRev * gearRatio) + zeroOffsetCounts);
-}
+double TiltDecoderConfig::countsToRad(std::int32_t counts) const { return units().toRad(counts); }
+
+std::int32_t TiltDecoderConfig::radToCounts(double rad) const { return units().toCounts(rad); }
 
 std::optional<TiltSample> TiltDecoder::decode(const CanMessage& f) {
   const auto node = static_cast<std::uint32_t>(config_.nodeId);

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "fusedet/drivers/canopen/tilt_units.h"
 #include "fusedet/drivers/log/channels.h"
 #include "fusedet/drivers/messages.h"
 
@@ -19,7 +20,8 @@ struct TiltDecoderConfig {
   double gearRatio = 50.0;
   long zeroOffsetCounts = 0;
 
-  double countsToRad(std::int64_t counts) const;
+  canopen::TiltUnits units() const;
+  double countsToRad(std::int32_t counts) const;
   std::int32_t radToCounts(double rad) const;
 };
 
