@@ -10,9 +10,10 @@
 // Reference case (the issue's): 162,336 features x 3,000 samples, 2 threads.
 // Equal terms, stated in the output: every peer's set-up is timed apart from its round (ours:
 // binning once per stage; XGBoost: QuantileDMatrix, built with as many threads as our binning;
-// ml::Boost: TrainData creation, and the presorting inside train(), found as the difference of a
-// one-round and a two-round training). ml::Boost is single-threaded by construction, so its ratio
-// is also given per thread (our round's time x our threads) beside the wall-clock one.
+// ml::Boost: TrainData creation and a training with zero weak trees, each timed directly; its round
+// from whole trainings with 1 and 2 trees, see below). ml::Boost is single-threaded by construction,
+// so its ratio is also given per thread (our round's CPU time over all our threads) beside the
+// wall-clock one.
 
 #include <opencv2/core.hpp>
 #include <opencv2/ml.hpp>
@@ -49,6 +50,40 @@ double processCpu() {
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
   return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
 }
+
+// Process CPU and wall seconds of one call.
+struct CpuWall {
+  double cpu = 0, wall = 0;
+};
+template <class F>
+CpuWall timed(F&& f) {
+  const double c0 = processCpu();
+  const auto t0 = Clock::now();
+  f();
+  return CpuWall{processCpu() - c0, since(t0)};
+}
+
+// ml::Boost's measured trainings: train[k] = every repetition of a training with k weak trees.
+struct MlBoostTimes {
+  CpuWall create;
+  std::vector<CpuWall> train[3];
+  CpuWall median(int trees) const {
+    std::vector<double> c, w;
+    for (const CpuWall& t : train[trees]) {
+      c.push_back(t.cpu);
+      w.push_back(t.wall);
+    }
+    auto mid = [](std::vector<double>& v) {  // median; the mean of the middle two for an even count
+      std::sort(v.begin(), v.end());
+      return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
+    };
+    return {mid(c), mid(w)};
+  }
+  CpuWall setup() const { return {create.cpu + median(0).cpu, create.wall + median(0).wall}; }
+  CpuWall round() const {
+    return {(median(2).cpu - median(0).cpu) / 2, (median(2).wall - median(0).wall) / 2};
+  }
+};
 
 // Resident set size and its peak, MB (from /proc/self/status).
 double procStatusMb(const char* key) {
@@ -105,6 +140,7 @@ struct XgBatches {
 struct Args {
   std::size_t features = 162336, samples = 3000;
   int threads = 2, rounds = 5;
+  int mlReps = 2;  // repetitions of ml::Boost's 0-, 1- and 2-tree trainings
   bool skipMlBoost = false;
   bool oursOnly = false;  // tuning: no peers, no headline ratios
   std::string source = "kitti";
@@ -142,18 +178,23 @@ Args parse(int argc, char** argv) {
       a.xgBuildThreads = std::stoi(next());
     } else if (s == "--ours-only") {
       a.oursOnly = true;
+    } else if (s == "--mlboost-reps") {
+      a.mlReps = std::max(1, std::stoi(next()));
     } else if (s == "--skip-mlboost") {
       a.skipMlBoost = true;
     } else if (s == "--help" || s == "-h") {
       std::printf(
           "boost_round_bench [--smoke] [--features N] [--samples N] [--threads T] [--rounds R]\n"
-          "                  [--source kitti|synthetic] [--skip-mlboost] [--ours-only] [--xgb-build-threads T]\n"
+          "                  [--source kitti|synthetic] [--skip-mlboost] [--mlboost-reps R] [--ours-only]\n"
+          "                  [--xgb-build-threads T]\n"
           "--source kitti (default): OpenCV's default pool (24-unit grid, types a-e) on intensity windows\n"
           "of the shared KITTI drives; synthetic: a generated matrix. --smoke: 3000 x 400, 3 frames/drive.\n"
           "One boosting round, ours vs XGBoost (hist) vs cv::ml::Boost, same matrix and threads.\n"
           "Defaults: 162336 features x 3000 samples, 2 threads, ours timed over 5 rounds. XGBoost's matrix is\n"
-          "built with --threads threads (as our binning) unless --xgb-build-threads says otherwise; ml::Boost\n"
-          "trains once with one and once with two weak trees: round = the difference, set-up = the rest.\n");
+          "built with --threads threads (as our binning) unless --xgb-build-threads says otherwise. ml::Boost's\n"
+          "set-up is timed directly (TrainData::create + train() with 0 weak trees); its trainings with 1 and 2\n"
+          "trees are timed whole, --mlboost-reps times each (default 2), interleaved; its round = (2-tree - 0-tree\n"
+          "training) / 2 of the medians. Every timing is printed.\n");
       std::exit(0);
     } else {
       throw std::runtime_error("unknown argument " + s);
@@ -299,13 +340,18 @@ int main(int argc, char** argv) try {
   XGDMatrixFree(it.proxy);
 
   // ---- cv::ml::Boost ----
-  // Single-threaded by construction. Its set-up (TrainData, presorting inside train()) cannot be
-  // called apart from a round, so it trains twice on the same TrainData: one weak tree, then two;
-  // the difference is one round, the rest of the one-tree time is set-up.
-  // Timed in process CPU seconds (its one thread's work; robust against a loaded machine) and
-  // wall seconds; the round is the two-tree minus the one-tree training.
-  double mlCreate = 0, mlTrain1 = 0, mlTrain2 = 0, mlRound = 0, mlSetup = 0, mlError = 0, mlRoundWall = 0,
-         mlSetupWall = 0;
+  // Single-threaded by construction. Every time printed is measured, none found by subtraction:
+  //   set-up: TrainData::create, then train() with zero weak trees - OpenCV's Boost::train runs
+  //     startTraining (work data, responses to +-1, weight normalisation), no tree, endTraining.
+  //     OpenCV 4 keeps no presorted index (each split sorts the node's values per feature, inside
+  //     the round), so this is all the set-up it has;
+  //   training with 1 and with 2 weak trees, whole. A round cannot be called apart from the set-up
+  //   through OpenCV's API, so its round is (train(2) - train(0)) / 2 of medians over --mlboost-reps
+  //   repetitions, run interleaved (0, 1, 2 trees, 0, 1, 2, ...) so load drift hits all alike; both
+  //   rounds (train(1) - train(0), train(2) - train(1)) are printed to show they agree.
+  // Timed in process CPU seconds (its one thread's work; robust against a loaded machine) and wall.
+  MlBoostTimes ml;
+  double mlError = 0;
   if (!a.skipMlBoost) {
     const double rssM = rssMb();
     cv::Mat X(static_cast<int>(N), static_cast<int>(F), CV_32F, const_cast<float*>(d.values.data()));
@@ -314,12 +360,10 @@ int main(int argc, char** argv) try {
     cv::Mat weights(static_cast<int>(N), 1, CV_32F, w.data());
     cv::Mat varType(static_cast<int>(F) + 1, 1, CV_8U, cv::Scalar(cv::ml::VAR_ORDERED));
     varType.at<uchar>(static_cast<int>(F)) = cv::ml::VAR_CATEGORICAL;
-    double c0 = processCpu();
-    t0 = Clock::now();
-    auto td = cv::ml::TrainData::create(X, cv::ml::ROW_SAMPLE, labels, cv::noArray(), cv::noArray(),
-                                        weights, varType);
-    mlCreate = processCpu() - c0;
-    const double wallCreate = since(t0);
+    cv::Ptr<cv::ml::TrainData> td;
+    ml.create = timed([&] {
+      td = cv::ml::TrainData::create(X, cv::ml::ROW_SAMPLE, labels, cv::noArray(), cv::noArray(), weights, varType);
+    });
     auto makeBoost = [](int weak) {
       auto boost = cv::ml::Boost::create();
       boost->setBoostType(cv::ml::Boost::GENTLE);
@@ -331,28 +375,21 @@ int main(int argc, char** argv) try {
       boost->setCVFolds(0);
       return boost;
     };
-    auto boost = makeBoost(1);
-    c0 = processCpu();
-    t0 = Clock::now();
-    boost->train(td);
-    mlTrain1 = processCpu() - c0;
-    const double wall1 = since(t0);
-    {
-      auto two = makeBoost(2);
-      c0 = processCpu();
-      t0 = Clock::now();
-      two->train(td);
-      mlTrain2 = processCpu() - c0;
-      mlRoundWall = since(t0) - wall1;
-    }
-    mlRound = mlTrain2 - mlTrain1;
-    mlSetup = mlCreate + mlTrain1 - mlRound;
-    mlSetupWall = wallCreate + wall1 - mlRoundWall;
+    cv::Ptr<cv::ml::Boost> oneTree;
+    for (int r = 0; r < a.mlReps; ++r)
+      for (int trees = 0; trees <= 2; ++trees) {
+        auto boost = makeBoost(trees);
+        ml.train[trees].push_back(timed([&] { boost->train(td); }));
+        if (trees == 1) oneTree = boost;
+        std::printf("ml::Boost: train() with %d weak tree(s), repetition %d: CPU %.4f s, wall %.4f s\n", trees, r + 1,
+                    ml.train[trees].back().cpu, ml.train[trees].back().wall);
+      }
+    if (oneTree->getRoots().size() != 1) throw std::runtime_error("ml::Boost did not train its one tree");
     const double rssAfter = rssMb();
     std::vector<float> mp(N);
     for (std::size_t i = 0; i < N; ++i)
-      mp[i] = boost->predict(X.row(static_cast<int>(i)), cv::noArray(),
-                            int(cv::ml::DTrees::PREDICT_SUM) | int(cv::ml::StatModel::RAW_OUTPUT));
+      mp[i] = oneTree->predict(X.row(static_cast<int>(i)), cv::noArray(),
+                               int(cv::ml::DTrees::PREDICT_SUM) | int(cv::ml::StatModel::RAW_OUTPUT));
     // OpenCV's Gentle leaves are the weighted mean of y in {-1, +1}; PREDICT_SUM|RAW_OUTPUT is
     // their sum (without PREDICT_SUM, Boost returns the class index).
     mlError = weightedError(mp, y, w);
@@ -362,10 +399,15 @@ int main(int argc, char** argv) try {
       u.erase(std::unique(u.begin(), u.end()), u.end());
       std::printf("ml::Boost: %zu distinct outputs, first %.4f last %.4f\n", u.size(), u.front(), u.back());
     }
-    std::printf("ml::Boost (1 thread by construction), CPU s: TrainData::create %.3f, train with 1 weak tree %.3f, "
-                "with 2 %.3f -> round %.3f (wall %.3f), set-up (create + presort + the rest) %.3f; error %.6f, "
-                "RSS +%.0f MB\n",
-                mlCreate, mlTrain1, mlTrain2, mlRound, mlRoundWall, mlSetup, mlError, rssAfter - rssM);
+    std::printf("ml::Boost (1 thread by construction), medians of %d, CPU s (wall s): TrainData::create %.4f (%.4f), "
+                "train() with 0 weak trees = the rest of its set-up %.4f (%.4f), with 1 %.3f (%.3f), with 2 %.3f "
+                "(%.3f)\n",
+                a.mlReps, ml.create.cpu, ml.create.wall, ml.median(0).cpu, ml.median(0).wall, ml.median(1).cpu,
+                ml.median(1).wall, ml.median(2).cpu, ml.median(2).wall);
+    std::printf("ml::Boost: set-up %.4f s CPU (create + 0-tree training); round = (2-tree - 0-tree training) / 2 = "
+                "%.3f s CPU (wall %.3f); first round %.3f, second round %.3f; error %.6f, RSS +%.0f MB\n",
+                ml.setup().cpu, ml.round().cpu, ml.round().wall, ml.median(1).cpu - ml.median(0).cpu,
+                ml.median(2).cpu - ml.median(1).cpu, mlError, rssAfter - rssM);
   }
   std::printf("memory: peak RSS %.0f MB\n", procStatusMb("VmHWM:"));
 
@@ -374,15 +416,16 @@ int main(int argc, char** argv) try {
   std::printf("bench: speedup_vs_xgboost %.2f\n", xgRound / oursSeconds);
   std::printf("bench: speedup_vs_xgboost_incl_setup %.2f\n", (xgSetup + xgRound) / (binSeconds + oursSeconds));
   if (!a.skipMlBoost) {
-    std::printf("equal terms: rounds against rounds, set-ups apart; ours and XGBoost on %d threads, ml::Boost on 1 "
-                "by construction: wall-clock ratio = its round's time / ours; per-thread ratio = its round's CPU "
-                "time / our round's CPU time over all our threads (%.4f s)\n",
+    std::printf("equal terms: rounds against rounds, set-ups timed apart (none by subtraction); ours and XGBoost on "
+                "%d threads, ml::Boost on 1 by construction: wall-clock ratio = its round's wall time / ours; "
+                "per-thread ratio = its round's CPU time / our round's CPU time over all our threads (%.4f s)\n",
                 a.threads, oursCpuSeconds);
-    std::printf("bench: mlboost_round_seconds %.3f\n", mlRound);
-    std::printf("bench: mlboost_setup_seconds %.3f\n", mlSetup);
-    std::printf("bench: speedup_vs_mlboost %.2f\n", mlRoundWall / oursSeconds);
-    std::printf("bench: speedup_vs_mlboost_per_thread %.2f\n", mlRound / oursCpuSeconds);
-    std::printf("bench: speedup_vs_mlboost_incl_setup %.2f\n", (mlSetupWall + mlRoundWall) / (binSeconds + oursSeconds));
+    std::printf("bench: mlboost_round_seconds %.3f\n", ml.round().cpu);
+    std::printf("bench: mlboost_setup_seconds %.4f\n", ml.setup().cpu);
+    std::printf("bench: speedup_vs_mlboost %.2f\n", ml.round().wall / oursSeconds);
+    std::printf("bench: speedup_vs_mlboost_per_thread %.2f\n", ml.round().cpu / oursCpuSeconds);
+    std::printf("bench: speedup_vs_mlboost_incl_setup %.2f\n",
+                (ml.setup().wall + ml.round().wall) / (binSeconds + oursSeconds));
   }
   std::printf("bench: stump_error_ratio_vs_xgboost %.5f\n", oursError / xgError);
   if (!a.skipMlBoost) std::printf("bench: stump_error_ratio_vs_mlboost %.5f\n", oursError / mlError);
