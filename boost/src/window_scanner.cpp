@@ -189,267 +189,118 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
 constexpr std::size_t kMaxVectorGrids = 8;
 
-// Corner values of four windows, gathered (origins b + o[k]) or, for neighbours whose origins are
-// `stride` (1 or 2) apart, loaded from the first one's origin p. The same values either way.
-__attribute__((target("avx2"))) inline __m256d corners4(const double* b, __m128i o, int stride) {
-  if (stride == 1) return _mm256_loadu_pd(b);
-  if (stride == 2) {
-    const __m256d lo = _mm256_loadu_pd(b), hi = _mm256_loadu_pd(b + 4);  // p0..p3, p4..p7
-    return _mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), 0xD8);        // p0 p4 p2 p6 -> p0 p2 p4 p6
-  }
-  // The masked form with every lane on: GCC 12 warns about the plain form's undefined source.
-  return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), b, o, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8);
-}
-__attribute__((target("avx2"))) inline __m128i corners4(const std::int32_t* b, __m128i o, int stride) {
-  if (stride == 1) return _mm_loadu_si128(reinterpret_cast<const __m128i*>(b));
-  if (stride == 2) {
-    const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
-    return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
-  }
-  return _mm_mask_i32gather_epi32(_mm_setzero_si128(), b, o, _mm_set1_epi32(-1), 4);
-}
+// The vector stage loops (vector_stages.inc) are written once against a `Lanes` type - the vector
+// width and its operations - and compiled once per instruction set, each copy under its own target
+// so that the AVX2 copy holds no AVX-512 instruction. Every lane does the scalar path's operations
+// in the same order (add/sub/div, no FMA), so the lanes equal stageScalar() bit for bit.
 
-// Rectangle sums of four windows, in rectSum()'s order (exact int32 arithmetic for int tables:
-// the integrals are monotone and below 2^31, so no step overflows).
-__attribute__((target("avx2"))) inline __m256d rectSum4(const double* b, __m128i o, int stride,
-                                                        const std::array<std::int32_t, 4>& c) {
-  const __m256d p0 = corners4(b + c[0], o, stride), p1 = corners4(b + c[1], o, stride);
-  const __m256d p2 = corners4(b + c[2], o, stride), p3 = corners4(b + c[3], o, stride);
-  return _mm256_add_pd(_mm256_sub_pd(_mm256_sub_pd(p3, p1), p2), p0);
-}
-__attribute__((target("avx2"))) inline __m256d rectSum4(const std::int32_t* b, __m128i o, int stride,
-                                                        const std::array<std::int32_t, 4>& c) {
-  const __m128i p0 = corners4(b + c[0], o, stride), p1 = corners4(b + c[1], o, stride);
-  const __m128i p2 = corners4(b + c[2], o, stride), p3 = corners4(b + c[3], o, stride);
-  return _mm256_cvtepi32_pd(_mm_add_epi32(_mm_sub_epi32(_mm_sub_epi32(p3, p1), p2), p0));
-}
-
-template <class T>
-__attribute__((target("avx2"))) inline void blackWhite4(const GridStump& z, const T* b, __m128i o, int stride,
-                                                        __m256d& black, __m256d& white) {
-  black = rectSum4(b, o, stride, z.ofs[0]);
-  if (z.checker) black = _mm256_add_pd(black, rectSum4(b, o, stride, z.ofs[1]));
-  white = rectSum4(b, o, stride, z.ofs[2]);
-}
-
-// Stage sums of four windows: every operation of stumpValue() and of the stage sum per lane, in
-// the same order (add/sub/div, no FMA), so lanes equal the scalar path. off[g]: the windows'
-// origins in grid g; first (row mode, may be null): the first window's origin per grid, for grids
-// whose neighbouring origins are regular (GridScale::colStride).
-__attribute__((target("avx2"))) inline __m256d stageSum4(const GridScale& sp, const GridStage& st,
-                                                         const void* const* grids, const __m128i* off,
-                                                         const std::int32_t* first) {
-  __m256d sum = _mm256_setzero_pd();
-  for (std::uint32_t k = st.begin; k < st.end; ++k) {
-    const GridStump& z = sp.stumps[k];
-    const auto g = static_cast<std::size_t>(z.grid);
-    const int stride = first ? sp.colStride[g] : 0;
-    const std::ptrdiff_t at = stride ? first[g] : 0;  // gathers add the lanes' own origins
-    __m256d black, white;
-    if (z.intGrid)
-      blackWhite4(z, static_cast<const std::int32_t*>(grids[g]) + at, off[g], stride, black, white);
-    else
-      blackWhite4(z, static_cast<const double*>(grids[g]) + at, off[g], stride, black, white);
-    if (z.whiteIsRest) white = _mm256_sub_pd(white, black);
-    const __m256d d = _mm256_sub_pd(_mm256_div_pd(black, _mm256_set1_pd(z.blackArea)),
-                                    _mm256_div_pd(white, _mm256_set1_pd(z.whiteArea)));
-    const __m256d v = _mm256_cvtps_pd(_mm256_cvtpd_ps(d));  // rounded to float, as featureValue()
-    const __m256d lt = _mm256_cmp_pd(v, _mm256_set1_pd(double(z.threshold)), _CMP_LT_OQ);
-    sum = _mm256_add_pd(sum, _mm256_blendv_pd(_mm256_set1_pd(z.right), _mm256_set1_pd(z.left), lt));
-  }
-  return sum;
-}
-
-__attribute__((target("avx2"))) inline int passMask(__m256d sum, double threshold) {
-  return _mm256_movemask_pd(_mm256_cmp_pd(sum, _mm256_set1_pd(threshold), _CMP_NLT_UQ));  // !(sum < threshold)
-}
-
-// A later stage on windows [0, n) of the list, four per step; keeps those that pass.
-__attribute__((target("avx2"))) std::size_t stageAvx2(const GridScale& sp, const GridStage& st,
-                                                      const void* const* grids, WindowList& l, std::size_t n) {
-  const std::size_t ng = l.grids;
-  std::size_t kept = 0;
-  alignas(32) double sums[4];
-  for (std::size_t i = 0; i < n; i += 4) {
-    __m128i off[kMaxVectorGrids];
-    for (std::size_t g = 0; g < ng; ++g) off[g] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(l.offsets(g) + i));
-    const __m256d sum = stageSum4(sp, st, grids, off, nullptr);
-    int pass = passMask(sum, st.threshold);
-    if (n - i < 4) pass &= (1 << (n - i)) - 1;
-    if (!pass) continue;
-    _mm256_store_pd(sums, sum);
-    for (int k = 0; k < 4; ++k)
-      if ((pass >> k) & 1) l.keep(i + std::size_t(k), kept++, sums[k]);
-  }
-  l.pad(kept);
-  return kept;
-}
-
-// Stage 0 on every window of rows [y0, y1) x columns [x0, x1), four neighbours per step with their
-// origins straight from the plan (no list to build: most windows end here); the survivors become
-// the list. colOfs carries four entries of padding.
-__attribute__((target("avx2"))) std::size_t firstStageAvx2(const GridScale& sp, const void* const* grids,
-                                                           std::size_t x0, std::size_t x1, std::size_t y0,
-                                                           std::size_t y1, WindowList& l) {
-  const std::size_t ng = l.grids;
-  const GridStage& st = sp.stages.front();
-  std::size_t kept = 0;
-  alignas(32) double sums[4];
-  alignas(16) std::int32_t lanes[kMaxVectorGrids][4];
-  for (std::size_t yi = y0; yi < y1; ++yi) {
-    __m128i row[kMaxVectorGrids];
-    for (std::size_t g = 0; g < ng; ++g) row[g] = _mm_set1_epi32(sp.rowOfs[g][yi]);
-    for (std::size_t xi = x0; xi < x1; xi += 4) {
-      __m128i off[kMaxVectorGrids];
-      std::int32_t first[kMaxVectorGrids];
-      for (std::size_t g = 0; g < ng; ++g) {
-        off[g] = _mm_add_epi32(row[g], _mm_loadu_si128(reinterpret_cast<const __m128i*>(sp.colOfs[g].data() + xi)));
-        first[g] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
-      }
-      const __m256d sum = stageSum4(sp, st, grids, off, first);
-      int pass = passMask(sum, st.threshold);
-      if (x1 - xi < 4) pass &= (1 << (x1 - xi)) - 1;
-      if (!pass) continue;
-      _mm256_store_pd(sums, sum);
-      for (std::size_t g = 0; g < ng; ++g) _mm_store_si128(reinterpret_cast<__m128i*>(lanes[g]), off[g]);
-      for (int k = 0; k < 4; ++k) {
-        if (!((pass >> k) & 1)) continue;
-        for (std::size_t g = 0; g < ng; ++g) l.offsets(g)[kept] = lanes[g][k];
-        l.xi[kept] = static_cast<std::int32_t>(xi + std::size_t(k));
-        l.yi[kept] = static_cast<std::int32_t>(yi);
-        l.score[kept] = sums[k];
-        ++kept;
-      }
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace avx2 {
+// Four windows per step: int32 offsets and table values in __m128i, doubles in __m256d.
+struct Lanes {
+  static constexpr std::size_t kCount = 4;
+  using Ints = __m128i;
+  using Doubles = __m256d;
+  static Ints loadInts(const std::int32_t* p) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+  static void storeInts(std::int32_t* p, Ints v) { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), v); }
+  static Ints splat(std::int32_t v) { return _mm_set1_epi32(v); }
+  static Ints add(Ints a, Ints b) { return _mm_add_epi32(a, b); }
+  static Ints sub(Ints a, Ints b) { return _mm_sub_epi32(a, b); }
+  // Corner values of the windows, gathered (origins b + o[k]) or, for neighbours whose origins are
+  // `stride` (1 or 2) apart, loaded from the first one's origin b. The same values either way.
+  static Doubles corners(const double* b, Ints o, int stride) {
+    if (stride == 1) return _mm256_loadu_pd(b);
+    if (stride == 2) {
+      const __m256d lo = _mm256_loadu_pd(b), hi = _mm256_loadu_pd(b + 4);  // p0..p3, p4..p7
+      return _mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), 0xD8);        // p0 p4 p2 p6 -> p0 p2 p4 p6
     }
+    // The masked form with every lane on: GCC 12 warns about the plain form's undefined source.
+    return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), b, o, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8);
   }
-  l.pad(kept);
-  return kept;
-}
+  static Ints corners(const std::int32_t* b, Ints o, int stride) {
+    if (stride == 1) return loadInts(b);
+    if (stride == 2) {
+      const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
+      return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
+    }
+    return _mm_mask_i32gather_epi32(_mm_setzero_si128(), b, o, _mm_set1_epi32(-1), 4);
+  }
+  static Doubles toDouble(Doubles v) { return v; }
+  static Doubles toDouble(Ints v) { return _mm256_cvtepi32_pd(v); }
+  static Doubles zero() { return _mm256_setzero_pd(); }
+  static Doubles splat(double v) { return _mm256_set1_pd(v); }
+  static Doubles add(Doubles a, Doubles b) { return _mm256_add_pd(a, b); }
+  static Doubles sub(Doubles a, Doubles b) { return _mm256_sub_pd(a, b); }
+  static Doubles div(Doubles a, Doubles b) { return _mm256_div_pd(a, b); }
+  static Doubles roundToFloat(Doubles v) { return _mm256_cvtps_pd(_mm256_cvtpd_ps(v)); }
+  // v < threshold ? left : right, per lane.
+  static Doubles choose(Doubles v, double threshold, double left, double right) {
+    const __m256d lt = _mm256_cmp_pd(v, splat(threshold), _CMP_LT_OQ);
+    return _mm256_blendv_pd(splat(right), splat(left), lt);
+  }
+  // Bit k set where !(sum[k] < threshold): window k passes the stage.
+  static int passMask(Doubles sum, double threshold) {
+    return _mm256_movemask_pd(_mm256_cmp_pd(sum, splat(threshold), _CMP_NLT_UQ));
+  }
+  static void store(double* p, Doubles v) { _mm256_storeu_pd(p, v); }
+};
+#include "vector_stages.inc"
+}  // namespace avx2
+#pragma GCC pop_options
 
-
-// The same with AVX-512: eight windows per step, the same per-lane operations in the same order.
-// (GCC 12's AVX-512 intrinsics start from undefined vectors, which -Wmaybe-uninitialized flags.)
+#pragma GCC push_options
+#pragma GCC target("avx512f")
+// GCC 12's AVX-512 intrinsics start from undefined vectors, which -Wmaybe-uninitialized flags.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-__attribute__((target("avx512f"))) inline __m512d corners8(const double* b, __m256i o, int stride) {
-  if (stride == 1) return _mm512_loadu_pd(b);
-  if (stride == 2)
-    return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14), _mm512_loadu_pd(b + 8));
-  return _mm512_i32gather_pd(o, b, 8);
-}
-__attribute__((target("avx512f"))) inline __m256i corners8(const std::int32_t* b, __m256i o, int stride) {
-  if (stride == 1) return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
-  if (stride == 2) {
-    const __m512i v = _mm512_loadu_si512(b);
-    return _mm512_castsi512_si256(
-        _mm512_permutexvar_epi32(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), v));
+namespace avx512 {
+// Eight windows per step: int32 offsets and table values in __m256i, doubles in __m512d.
+struct Lanes {
+  static constexpr std::size_t kCount = 8;
+  using Ints = __m256i;
+  using Doubles = __m512d;
+  static Ints loadInts(const std::int32_t* p) { return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(p)); }
+  static void storeInts(std::int32_t* p, Ints v) { _mm256_storeu_si256(reinterpret_cast<__m256i*>(p), v); }
+  static Ints splat(std::int32_t v) { return _mm256_set1_epi32(v); }
+  static Ints add(Ints a, Ints b) { return _mm256_add_epi32(a, b); }
+  static Ints sub(Ints a, Ints b) { return _mm256_sub_epi32(a, b); }
+  static Doubles corners(const double* b, Ints o, int stride) {  // as avx2::Lanes::corners
+    if (stride == 1) return _mm512_loadu_pd(b);
+    if (stride == 2)
+      return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14),
+                                    _mm512_loadu_pd(b + 8));
+    return _mm512_i32gather_pd(o, b, 8);
   }
-  return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), b, o, _mm256_set1_epi32(-1), 4);
-}
-__attribute__((target("avx512f"))) inline __m512d rectSum8(const double* b, __m256i o, int stride,
-                                                           const std::array<std::int32_t, 4>& c) {
-  const __m512d p0 = corners8(b + c[0], o, stride), p1 = corners8(b + c[1], o, stride);
-  const __m512d p2 = corners8(b + c[2], o, stride), p3 = corners8(b + c[3], o, stride);
-  return _mm512_add_pd(_mm512_sub_pd(_mm512_sub_pd(p3, p1), p2), p0);
-}
-__attribute__((target("avx512f"))) inline __m512d rectSum8(const std::int32_t* b, __m256i o, int stride,
-                                                           const std::array<std::int32_t, 4>& c) {
-  const __m256i p0 = corners8(b + c[0], o, stride), p1 = corners8(b + c[1], o, stride);
-  const __m256i p2 = corners8(b + c[2], o, stride), p3 = corners8(b + c[3], o, stride);
-  return _mm512_cvtepi32_pd(_mm256_add_epi32(_mm256_sub_epi32(_mm256_sub_epi32(p3, p1), p2), p0));
-}
-template <class T>
-__attribute__((target("avx512f"))) inline void blackWhite8(const GridStump& z, const T* b, __m256i o, int stride,
-                                                           __m512d& black, __m512d& white) {
-  black = rectSum8(b, o, stride, z.ofs[0]);
-  if (z.checker) black = _mm512_add_pd(black, rectSum8(b, o, stride, z.ofs[1]));
-  white = rectSum8(b, o, stride, z.ofs[2]);
-}
-__attribute__((target("avx512f"))) inline __m512d stageSum8(const GridScale& sp, const GridStage& st,
-                                                            const void* const* grids, const __m256i* off,
-                                                            const std::int32_t* first) {
-  __m512d sum = _mm512_setzero_pd();
-  for (std::uint32_t k = st.begin; k < st.end; ++k) {
-    const GridStump& z = sp.stumps[k];
-    const auto g = static_cast<std::size_t>(z.grid);
-    const int stride = first ? sp.colStride[g] : 0;
-    const std::ptrdiff_t at = stride ? first[g] : 0;
-    __m512d black, white;
-    if (z.intGrid)
-      blackWhite8(z, static_cast<const std::int32_t*>(grids[g]) + at, off[g], stride, black, white);
-    else
-      blackWhite8(z, static_cast<const double*>(grids[g]) + at, off[g], stride, black, white);
-    if (z.whiteIsRest) white = _mm512_sub_pd(white, black);
-    const __m512d d = _mm512_sub_pd(_mm512_div_pd(black, _mm512_set1_pd(z.blackArea)),
-                                    _mm512_div_pd(white, _mm512_set1_pd(z.whiteArea)));
-    const __m512d v = _mm512_cvtps_pd(_mm512_cvtpd_ps(d));  // rounded to float, as featureValue()
-    const __mmask8 lt = _mm512_cmp_pd_mask(v, _mm512_set1_pd(double(z.threshold)), _CMP_LT_OQ);
-    sum = _mm512_add_pd(sum, _mm512_mask_blend_pd(lt, _mm512_set1_pd(z.right), _mm512_set1_pd(z.left)));
-  }
-  return sum;
-}
-__attribute__((target("avx512f"))) inline int passMask8(__m512d sum, double threshold) {
-  return static_cast<int>(_mm512_cmp_pd_mask(sum, _mm512_set1_pd(threshold), _CMP_NLT_UQ));
-}
-
-__attribute__((target("avx512f"))) std::size_t stageAvx512(const GridScale& sp, const GridStage& st,
-                                                           const void* const* grids, WindowList& l, std::size_t n) {
-  const std::size_t ng = l.grids;
-  std::size_t kept = 0;
-  alignas(64) double sums[8];
-  for (std::size_t i = 0; i < n; i += 8) {
-    __m256i off[kMaxVectorGrids];
-    for (std::size_t g = 0; g < ng; ++g) off[g] = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l.offsets(g) + i));
-    const __m512d sum = stageSum8(sp, st, grids, off, nullptr);
-    int pass = passMask8(sum, st.threshold);
-    if (n - i < 8) pass &= (1 << (n - i)) - 1;
-    if (!pass) continue;
-    _mm512_store_pd(sums, sum);
-    for (int k = 0; k < 8; ++k)
-      if ((pass >> k) & 1) l.keep(i + std::size_t(k), kept++, sums[k]);
-  }
-  l.pad(kept);
-  return kept;
-}
-
-__attribute__((target("avx512f"))) std::size_t firstStageAvx512(const GridScale& sp, const void* const* grids,
-                                                                std::size_t x0, std::size_t x1, std::size_t y0,
-                                                                std::size_t y1, WindowList& l) {
-  const std::size_t ng = l.grids;
-  const GridStage& st = sp.stages.front();
-  std::size_t kept = 0;
-  alignas(64) double sums[8];
-  alignas(32) std::int32_t lanes[kMaxVectorGrids][8];
-  for (std::size_t yi = y0; yi < y1; ++yi) {
-    for (std::size_t xi = x0; xi < x1; xi += 8) {
-      __m256i off[kMaxVectorGrids];
-      std::int32_t first[kMaxVectorGrids];
-      for (std::size_t g = 0; g < ng; ++g) {
-        off[g] = _mm256_add_epi32(_mm256_set1_epi32(sp.rowOfs[g][yi]),
-                                  _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sp.colOfs[g].data() + xi)));
-        first[g] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
-      }
-      const __m512d sum = stageSum8(sp, st, grids, off, first);
-      int pass = passMask8(sum, st.threshold);
-      if (x1 - xi < 8) pass &= (1 << (x1 - xi)) - 1;
-      if (!pass) continue;
-      _mm512_store_pd(sums, sum);
-      for (std::size_t g = 0; g < ng; ++g) _mm256_store_si256(reinterpret_cast<__m256i*>(lanes[g]), off[g]);
-      for (int k = 0; k < 8; ++k) {
-        if (!((pass >> k) & 1)) continue;
-        for (std::size_t g = 0; g < ng; ++g) l.offsets(g)[kept] = lanes[g][k];
-        l.xi[kept] = static_cast<std::int32_t>(xi + std::size_t(k));
-        l.yi[kept] = static_cast<std::int32_t>(yi);
-        l.score[kept] = sums[k];
-        ++kept;
-      }
+  static Ints corners(const std::int32_t* b, Ints o, int stride) {
+    if (stride == 1) return loadInts(b);
+    if (stride == 2) {
+      const __m512i v = _mm512_loadu_si512(b);
+      return _mm512_castsi512_si256(
+          _mm512_permutexvar_epi32(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), v));
     }
+    return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), b, o, _mm256_set1_epi32(-1), 4);
   }
-  l.pad(kept);
-  return kept;
-}
-
+  static Doubles toDouble(Doubles v) { return v; }
+  static Doubles toDouble(Ints v) { return _mm512_cvtepi32_pd(v); }
+  static Doubles zero() { return _mm512_setzero_pd(); }
+  static Doubles splat(double v) { return _mm512_set1_pd(v); }
+  static Doubles add(Doubles a, Doubles b) { return _mm512_add_pd(a, b); }
+  static Doubles sub(Doubles a, Doubles b) { return _mm512_sub_pd(a, b); }
+  static Doubles div(Doubles a, Doubles b) { return _mm512_div_pd(a, b); }
+  static Doubles roundToFloat(Doubles v) { return _mm512_cvtps_pd(_mm512_cvtpd_ps(v)); }
+  static Doubles choose(Doubles v, double threshold, double left, double right) {
+    return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(v, splat(threshold), _CMP_LT_OQ), splat(right), splat(left));
+  }
+  static int passMask(Doubles sum, double threshold) {
+    return static_cast<int>(_mm512_cmp_pd_mask(sum, splat(threshold), _CMP_NLT_UQ));
+  }
+  static void store(double* p, Doubles v) { _mm512_storeu_pd(p, v); }
+};
+#include "vector_stages.inc"
+}  // namespace avx512
 #pragma GCC diagnostic pop
+#pragma GCC pop_options
 
 // Widest path the CPU, the vector switch and the lane limit allow: 8, 4 or 1 lanes.
 int vectorLanes(std::size_t grids) {
@@ -494,8 +345,8 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
   stumps += windows * (sp.stages.front().end - sp.stages.front().begin);
   std::size_t n = 0;
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-  if (lanes == 8) n = firstStageAvx512(sp, grids, x0, x1, y0, y1, l);
-  if (lanes == 4) n = firstStageAvx2(sp, grids, x0, x1, y0, y1, l);
+  if (lanes == 8) n = avx512::firstStage(sp, grids, x0, x1, y0, y1, l);
+  if (lanes == 4) n = avx2::firstStage(sp, grids, x0, x1, y0, y1, l);
 #endif
   if (lanes == 1) n = firstStageScalar(sp, grids, x0, x1, y0, y1, l);
   for (std::size_t s = 1; s < sp.stages.size() && n > 0; ++s) {
@@ -503,11 +354,11 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
     stumps += n * (st.end - st.begin);
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
     if (lanes == 8) {
-      n = stageAvx512(sp, st, grids, l, n);
+      n = avx512::laterStage(sp, st, grids, l, n);
       continue;
     }
     if (lanes == 4) {
-      n = stageAvx2(sp, st, grids, l, n);
+      n = avx2::laterStage(sp, st, grids, l, n);
       continue;
     }
 #endif
