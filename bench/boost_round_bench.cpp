@@ -20,6 +20,8 @@
 #include <tbb/global_control.h>
 #include <xgboost/c_api.h>
 
+#include <CLI/CLI.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -149,56 +151,42 @@ struct Args {
   int xgBuildThreads = 0;      // threads of its QuantileDMatrix construction; 0 = --threads (as our binning)
 };
 
+// Command line (CLI11); exits after --help (0) or a bad argument (non-zero).
 Args parse(int argc, char** argv) {
   Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(s + " needs a value");
-      return argv[++i];
-    };
-    if (s == "--smoke") {
-      a.features = 3000;
-      a.samples = 400;
-      a.rounds = 2;
-      a.maxFrames = 3;
-    } else if (s == "--features") {
-      a.features = std::stoul(next());
-    } else if (s == "--samples") {
-      a.samples = std::stoul(next());
-    } else if (s == "--threads") {
-      a.threads = std::stoi(next());
-    } else if (s == "--rounds") {
-      a.rounds = std::stoi(next());
-    } else if (s == "--source") {
-      a.source = next();
-    } else if (s == "--xgb-batch") {
-      a.xgBatch = std::stoul(next());
-    } else if (s == "--xgb-build-threads") {
-      a.xgBuildThreads = std::stoi(next());
-    } else if (s == "--ours-only") {
-      a.oursOnly = true;
-    } else if (s == "--mlboost-reps") {
-      a.mlReps = std::max(1, std::stoi(next()));
-    } else if (s == "--skip-mlboost") {
-      a.skipMlBoost = true;
-    } else if (s == "--help" || s == "-h") {
-      std::printf(
-          "boost_round_bench [--smoke] [--features N] [--samples N] [--threads T] [--rounds R]\n"
-          "                  [--source kitti|synthetic] [--skip-mlboost] [--mlboost-reps R] [--ours-only]\n"
-          "                  [--xgb-build-threads T]\n"
-          "--source kitti (default): OpenCV's default pool (24-unit grid, types a-e) on intensity windows\n"
-          "of the shared KITTI drives; synthetic: a generated matrix. --smoke: 3000 x 400, 3 frames/drive.\n"
-          "One boosting round, ours vs XGBoost (hist) vs cv::ml::Boost, same matrix and threads.\n"
-          "Defaults: 162336 features x 3000 samples, 2 threads, ours timed over 5 rounds. XGBoost's matrix is\n"
-          "built with --threads threads (as our binning) unless --xgb-build-threads says otherwise. ml::Boost's\n"
-          "set-up is timed directly (TrainData::create + train() with 0 weak trees); its trainings with 1 and 2\n"
-          "trees are timed whole, --mlboost-reps times each (default 2), interleaved; its round = (2-tree - 0-tree\n"
-          "training) / 2 of the medians. Every timing is printed.\n");
-      std::exit(0);
-    } else {
-      throw std::runtime_error("unknown argument " + s);
-    }
+  CLI::App app{
+      "bench_boost_round - one boosting round, ours vs XGBoost (hist) vs cv::ml::Boost, same matrix and threads.\n"
+      "Matrix: OpenCV's default pool (24-unit grid, types a-e) on intensity windows of the shared KITTI drives\n"
+      "(--source kitti) or a generated one (--source synthetic). XGBoost's matrix is built with --threads threads\n"
+      "(as our binning) unless --xgb-build-threads says otherwise. ml::Boost's set-up is timed directly\n"
+      "(TrainData::create + train() with 0 weak trees); its trainings with 1 and 2 trees are timed whole,\n"
+      "--mlboost-reps times each, interleaved; its round = (2-tree - 0-tree training) / 2 of the medians.\n"
+      "Every timing is printed."};
+  bool smoke = false;
+  app.add_flag("--smoke", smoke, "tiny run for ctest: 3000 features x 400 samples, 3 frames per drive, 2 rounds");
+  app.add_option("--features", a.features, "features (pool size)")->capture_default_str();
+  app.add_option("--samples", a.samples, "samples")->capture_default_str();
+  app.add_option("--threads", a.threads, "threads of ours and XGBoost")->capture_default_str();
+  app.add_option("--rounds", a.rounds, "rounds timed (ours, XGBoost)")->capture_default_str();
+  app.add_option("--source", a.source, "kitti or synthetic")->capture_default_str();
+  app.add_option("--xgb-batch", a.xgBatch, "rows per batch fed to XGBoost's QuantileDMatrix")->capture_default_str();
+  app.add_option("--xgb-build-threads", a.xgBuildThreads, "threads of XGBoost's matrix (0 = --threads)")
+      ->capture_default_str();
+  app.add_option("--mlboost-reps", a.mlReps, "repetitions of ml::Boost's 0-, 1- and 2-tree trainings")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--skip-mlboost", a.skipMlBoost, "leave ml::Boost out");
+  app.add_flag("--ours-only", a.oursOnly, "tuning: ours only, no peers, no headline ratios");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
+  }
+  if (smoke) {
+    a.features = 3000;
+    a.samples = 400;
+    a.rounds = 2;
+    a.maxFrames = 3;
   }
   return a;
 }

@@ -29,6 +29,8 @@
 #include <thread>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
@@ -87,30 +89,26 @@ struct Args {
   std::string drive = "kitti";
 };
 
+// Command line (CLI11); exits after --help (0) or a bad argument (non-zero).
 Args parse(int argc, char** argv) {
   Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(s + " needs a value");
-      return argv[++i];
-    };
-    if (s == "--rounds") a.rounds = std::max(1, std::stoi(next()));
-    else if (s == "--smoke") a.rounds = 1;
-    else if (s == "--data") a.data = next();
-    else if (s == "--models") a.models = next();
-    else if (s == "--drive") a.drive = next();
-    else if (s == "--help" || s == "-h") {
-      std::printf(
-          "bench_detect3 [--rounds N] [--smoke] [--data DIR] [--drive NAME] [--models DIR]\n"
-          "The three bundled models on the first held-back frame of the drive (fused), one pass, vs the\n"
-          "previous per-class path and vs OpenCV's frontalface_default on the intensity layer, rounds\n"
-          "interleaved; medians of thread CPU time. Defaults: 15 rounds, drive kitti, the source tree's models/.\n");
-      std::exit(0);
-    } else {
-      throw std::runtime_error("unknown argument " + s);
-    }
+  CLI::App app{
+      "bench_detect3 - the three bundled models on the first held-back frame of the drive (fused), one pass, vs\n"
+      "the previous per-class path and vs OpenCV's frontalface_default on the intensity layer, rounds\n"
+      "interleaved; medians of thread CPU time."};
+  bool smoke = false;
+  app.add_option("--rounds", a.rounds, "rounds (each times every contender once)")->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_flag("--smoke", smoke, "one round (ctest)");
+  app.add_option("--data", a.data, "root of the shared data")->capture_default_str();
+  app.add_option("--drive", a.drive, "KITTI drive folder under --data")->capture_default_str();
+  app.add_option("--models", a.models, "folder with car.json, person.json, bike.json")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
   }
+  if (smoke) a.rounds = 1;
   return a;
 }
 

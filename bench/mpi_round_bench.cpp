@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "boost_round_data.h"
 #include "fusedet/boost/gentle_boost.h"
 #include "fusedet/boost/sharded_samples.h"
@@ -40,42 +42,30 @@ struct Args {
   std::string mpirun = FUSEDET_MPIRUN;
 };
 
+// Command line (CLI11); exits after --help (0) or a bad argument (non-zero).
 Args parse(int argc, char** argv) {
   Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string s = argv[i];
-    auto next = [&]() -> std::string {
-      if (i + 1 >= argc) throw std::runtime_error(s + " needs a value");
-      return argv[++i];
-    };
-    if (s == "--smoke") {
-      a.smoke = true;
-      a.features = 2000;
-      a.samples = 400;
-      a.frames = 3;
-      a.rounds = 2;
-    } else if (s == "--worker") {
-      a.worker = true;
-    } else if (s == "--features") {
-      a.features = std::stoul(next());
-    } else if (s == "--samples") {
-      a.samples = std::stoul(next());
-    } else if (s == "--frames") {
-      a.frames = std::stoul(next());
-    } else if (s == "--rounds") {
-      a.rounds = std::stoi(next());
-    } else if (s == "--threads") {
-      a.threads = std::stoi(next());
-    } else if (s == "--mpirun") {
-      a.mpirun = next();
-    } else {
-      std::cerr << "bench_mpi_round [--smoke] [--features N] [--samples N] [--frames F] [--rounds R] [--threads T]\n"
-                   "                [--mpirun PATH]\n"
-                   "Times boosting rounds of the sharded trainer under mpirun -np 1 and -np 2 (T threads per\n"
-                   "rank, default 1) and the bytes each rank hands to MPI per round. --smoke: 2000 features,\n"
-                   "400 samples, 3 frames per drive, 2 rounds.\n";
-      std::exit(s == "--help" ? 0 : 2);
-    }
+  CLI::App app{
+      "bench_mpi_round - boosting rounds of the sharded trainer under mpirun -np 1 and -np 2 (T threads per\n"
+      "rank) and the bytes each rank hands to MPI per round."};
+  app.add_flag("--smoke", a.smoke, "tiny run for ctest: 2000 features, 400 samples, 3 frames per drive, 2 rounds");
+  app.add_flag("--worker", a.worker, "run as one rank (the driver starts its ranks so)");
+  app.add_option("--features", a.features, "features (pool size)")->capture_default_str();
+  app.add_option("--samples", a.samples, "samples")->capture_default_str();
+  app.add_option("--frames", a.frames, "frames per drive (0 = all)")->capture_default_str();
+  app.add_option("--rounds", a.rounds, "rounds timed")->capture_default_str();
+  app.add_option("--threads", a.threads, "threads per rank")->capture_default_str();
+  app.add_option("--mpirun", a.mpirun, "MPI launcher")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    std::exit(app.exit(e));
+  }
+  if (a.smoke) {
+    a.features = 2000;
+    a.samples = 400;
+    a.frames = 3;
+    a.rounds = 2;
   }
   return a;
 }
