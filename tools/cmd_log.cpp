@@ -52,7 +52,7 @@ const bool registered = registerCommand(
       app.require_subcommand(1);
       CLI::App* info = app.add_subcommand("info", "channels, message counts, time span, rates, gaps and damage of a log");
       info->add_option("LOG", o->file, "an MCAP file")->required();
-      info->add_option("--gap-factor", o->gapFactor, "an interval longer than this many median periods counts as a gap")
+      info->add_option("--gap-factor", o->gapFactor, "an interval longer than this many usual periods (90th percentile of the intervals) counts as a gap")
           ->capture_default_str();
       CLI::App* exp = app.add_subcommand("export", "write a log's CAN frames, camera frames or sweeps in other tools' formats");
       exp->add_option("LOG", o->file, "an MCAP file")->required();
@@ -64,7 +64,7 @@ const bool registered = registerCommand(
           "read up to its last complete chunk and the report says where it was cut ('truncated cut at byte N inside\n"
           "a Chunk record starting at byte M ...'); chunks whose CRC or compression is damaged are skipped and\n"
           "listed as problems. Per channel: topic, schema, messages, span, mean rate, largest interval and the\n"
-          "number of intervals longer than --gap-factor median periods.\n"
+          "number of intervals longer than --gap-factor usual periods (90th percentile).\n"
           "export decodes camera frames as the live pipeline does (YUYV/MJPEG -> BGR) and takes the sweeps the log\n"
           "recorded, or assembles them from its raw laser and CAN streams with the rig in its fusedet.config.\n"
           "candump stamps are the log's CLOCK_MONOTONIC seconds.\n"

@@ -36,14 +36,17 @@ int run(SynthCliOptions o) {
   std::printf("wrote    %s (%ju bytes) in %.2f s\n", o.out.c_str(), static_cast<std::uintmax_t>(fs::file_size(o.out)), took);
   std::printf("scene    %s\nframes  ", r.scene.c_str());
   for (const std::string& id : r.frameIds) std::printf(" %s", id.c_str());
-  std::printf("\nlog      %.3f s: %zu strokes of %.3f s\n", r.seconds, r.frameIds.size(), r.strokeS);
+  std::printf("\nlog      %.3f s: tilt start-up %.3f s, then %zu strokes of %.3f s\n", r.seconds, r.startupS, r.frameIds.size(),
+              r.strokeS);
   std::printf("laser    %ju scans, %ju beams, %.1f %% with a return; %ju bytes in %ju reads at %d baud\n",
               static_cast<std::uintmax_t>(r.scans), static_cast<std::uintmax_t>(r.beams),
               r.beams ? 100.0 * static_cast<double>(r.hits) / static_cast<double>(r.beams) : 0.0,
               static_cast<std::uintmax_t>(r.serialBytes), static_cast<std::uintmax_t>(r.serialChunks), r.rig.baud);
-  std::printf("can      %ju frames (SYNC, TPDO1, heartbeat; node %d)\ncamera   %ju YUYV frames %dx%d\n",
-              static_cast<std::uintmax_t>(r.canFrames), r.rig.nodeId, static_cast<std::uintmax_t>(r.cameraFrames),
-              r.rig.camera.width, r.rig.camera.height);
+  std::printf("can      %ju frames of TiltDrive and the CiA 402 motor simulator (node %d: %ju SDO requests, %ju TPDO1)\n"
+              "camera   %ju YUYV frames %dx%d\n",
+              static_cast<std::uintmax_t>(r.canFrames), r.rig.tilt.node, static_cast<std::uintmax_t>(r.sdoRequests),
+              static_cast<std::uintmax_t>(r.tpdos), static_cast<std::uintmax_t>(r.cameraFrames), r.rig.camera.width,
+              r.rig.camera.height);
   return 0;
 }
 
@@ -63,8 +66,11 @@ const bool registered = registerCommand(
       app.footer(
           "The log is what fusedet record would have written on a robot with this rig: a SICK LMS 291 (100 deg / 1 deg,\n"
           "range + remission telegrams, cm units) at 500 kbaud on a nodding unit (CiA 402 drive, CAN node 5, -3..16 deg\n"
-          "at 15 deg/s), and KITTI's colour camera 2 (YUYV). Each KITTI frame is one nodding stroke (~1.37 s; the scene\n"
-          "stands still meanwhile). Every beam's direction comes from its scan angle and the tilt at its time; its range\n"
+          "at 15 deg/s), and KITTI's colour camera 2 (YUYV). The CAN traffic is fusedet's own tilt drive (the live CANopen\n"
+          "master) against the CiA 402 motor simulator on a simulated-time bus: NMT boot-up, SDO configuration, SYNC,\n"
+          "TPDO1 (position + statusword), heartbeats, set-point handshakes, the stop at the end. Laser and camera start\n"
+          "with the first full sweep. Each KITTI frame is one nodding stroke (~1.5 s; the scene stands still meanwhile).\n"
+          "Every beam's direction comes from its scan angle and the simulated motor's angle at its time; its range\n"
           "and remission from the nearest Velodyne return along that ray (within --tolerance-deg). The rig is stored as\n"
           "metadata fusedet.config (config.yaml, camera.yaml); replay with it reproduces the geometry. Format:\n"
           "docs/log-format.md. Without KITTI data (and with --procedural) the scene is procedural.\n"

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "fusedet/daemon/tilt_source.h"
 #include "fusedet/fusion/camera_model.h"
 
 namespace fusedet::daemon {
@@ -16,11 +17,8 @@ drivers::lms291::Lms291Config laserConfig(const Config& c) {
   return l;
 }
 
-drivers::logs::TiltDecoderConfig tiltUnits(const Config& c) {
-  return drivers::logs::TiltDecoderConfig{c.tilt.nodeId, c.tilt.countsPerRev, c.tilt.gearRatio, c.tilt.zeroOffsetCounts};
-}
-
-drivers::logs::SensorReplayConfig sensorReplayConfig(const Config& c) { return {laserConfig(c), tiltUnits(c)}; }
+// The tilt settings are the live drive's (tiltDriveConfigFrom): replay decodes TPDO1 with them.
+drivers::logs::SensorReplayConfig sensorReplayConfig(const Config& c) { return {laserConfig(c), tiltDriveConfigFrom(c.tilt)}; }
 
 fusion::SweepConfig sweepConfig(const Config& c) {
   fusion::SweepConfig s;

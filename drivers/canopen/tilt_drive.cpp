@@ -47,7 +47,8 @@ std::string_view toString(TiltPhase p) {
 }
 
 TiltDrive::TiltDrive(CanBus& bus, TiltDriveConfig config, SampleHandler onSample)
-    : bus_(bus), config_(std::move(config)), onSample_(std::move(onSample)), sdo_(bus, config_.node, config_.sdoTimeout) {}
+    : bus_(bus), config_(std::move(config)), onSample_(std::move(onSample)), sdo_(bus, config_.node, config_.sdoTimeout),
+      tpdo_(config_.node, config_.units) {}
 
 void TiltDrive::setFaultHandler(FaultHandler h) {
   std::lock_guard lock(mutex_);
@@ -263,7 +264,7 @@ void TiltDrive::beginMove() {
   if (motion_ == Motion::kNod) {
     if (!positioned_) {
       // First go to the nearer end; from there every move is a full sweep.
-      const double at = lastSample_ ? lastSample_->angle : 0.0;
+      const double at = tpdo_.last() ? tpdo_.last()->angle : 0.0;
       nextToMax_ = std::abs(at - maxRad()) < std::abs(at - minRad());
     }
     target = nextToMax_ ? maxRad() : minRad();
@@ -271,7 +272,7 @@ void TiltDrive::beginMove() {
   moveTarget_ = config_.units.toCounts(target);
   move_ = MoveStep::kCommanding;
   sweepSamples_ = 0;
-  sweepMin_ = sweepMax_ = lastSample_ ? lastSample_->angle : 0.0;
+  sweepMin_ = sweepMax_ = tpdo_.last() ? tpdo_.last()->angle : 0.0;
   ackPolls_ = 0;
   sdo_.download(od::kTargetPosition, 0, static_cast<std::uint32_t>(moveTarget_), 4, expectOk());
   sdo_.download(od::kControlword, 0, cw::kEnableOperation | cw::kNewSetPoint | cw::kChangeImmediately, 2, expectOk());
@@ -325,19 +326,14 @@ void TiltDrive::handleEmcy(const CanFrame& f) {
 }
 
 void TiltDrive::handleTpdo(const CanFrame& f) {
-  if (f.len < 6) {
+  const std::optional<TiltTpdo> t = tpdo_.decode(f);
+  if (!t) {
     ++counters_.badPdos;
     return;
   }
-  const auto counts = static_cast<std::int32_t>(readLe(f.data, 0, 4));
-  const auto s = static_cast<std::uint16_t>(readLe(f.data, 4, 2));
+  const std::uint16_t s = t->statusword;
   counters_.statusword = s;
-  TiltSample sample;
-  sample.stamp = f.stamp;
-  sample.angle = config_.units.toRad(counts);
-  if (lastSample_ && f.stamp > lastSample_->stamp && f.stamp - lastSample_->stamp < 500'000'000)
-    sample.velocity = (sample.angle - lastSample_->angle) / (static_cast<double>(f.stamp - lastSample_->stamp) * 1e-9);
-  lastSample_ = sample;
+  const TiltSample& sample = t->sample;
   ++counters_.samples;
   ++sweepSamples_;
   sweepMin_ = std::min(sweepMin_, sample.angle);
@@ -384,7 +380,7 @@ void TiltDrive::onFrame(const CanFrame& f) {
   const auto n = static_cast<std::uint32_t>(config_.node);
   if (f.id == cob::kHeartbeat + n) handleHeartbeat(f);
   else if (f.id == cob::kEmcy + n) handleEmcy(f);
-  else if (f.id == cob::kTpdo1 + n) handleTpdo(f);
+  else if (tpdo_.isTpdo(f)) handleTpdo(f);
 }
 
 void TiltDrive::poll(Stamp now) {

@@ -37,12 +37,15 @@ LogInfo inspectLog(const mcap::McapReader& reader, double gapFactor) {
     if (t.size() >= 2) {
       std::vector<double> periods;
       for (std::size_t i = 1; i < t.size(); ++i) periods.push_back(static_cast<double>(t[i] - t[i - 1]) * 1e-9);
+      // Bursty streams (a telegram in several reads, SYNC + TPDO in the same millisecond) have a
+      // tiny median interval: the usual pause between bursts is the 90th percentile.
       std::vector<double> sorted = periods;
-      std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
-      c.medianPeriodS = sorted[sorted.size() / 2];
+      const std::size_t p90 = sorted.size() * 9 / 10;
+      std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(p90), sorted.end());
+      c.usualPeriodS = sorted[p90];
       c.maxGapS = *std::max_element(periods.begin(), periods.end());
       for (double p : periods)
-        if (p > gapFactor * c.medianPeriodS && p > 1e-3) ++c.gaps;
+        if (p > gapFactor * c.usualPeriodS && p > 1e-3) ++c.gaps;
     }
     info.channels.push_back(std::move(c));
   }

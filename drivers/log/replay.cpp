@@ -3,6 +3,7 @@
 #include <thread>
 
 #include "fusedet/drivers/lms291/link.h"
+#include "fusedet/drivers/log/candump.h"
 
 namespace fusedet::drivers::logs {
 
@@ -79,7 +80,7 @@ bool LogSource::step(const Handlers& h, const std::atomic<bool>* stop) {
 }
 
 SensorReplay::SensorReplay(const std::filesystem::path& log, SensorReplayConfig config, ReplayOptions options)
-    : source_(log, options), config_(std::move(config)), tilt_(config_.tilt) {
+    : source_(log, options), config_(std::move(config)), tilt_(config_.tilt.node, config_.tilt.units) {
   const lms291::Lms291Config& l = config_.laser;
   // What Lms291::start() sets the device to: the unit, and measuring mode 0x0D for range+remission.
   scans_.reset(l.variant, l.remission, l.remission ? lms291::kMeasuringRemission : l.measuringMode, l.unit);
@@ -110,7 +111,9 @@ bool SensorReplay::step(const Handlers& h, const std::atomic<bool>* stop) {
   LogSource::Handlers raw;
   raw.serial = [&](const SerialChunk& c) { onSerial(c, h); };
   raw.can = [&](const CanMessage& c) {
-    if (auto s = tilt_.decode(c); s && h.tilt) h.tilt(*s);
+    const canopen::CanFrame f = toCanFrame(c);
+    if (!tilt_.isTpdo(f)) return;  // SYNC, heartbeats, SDO, NMT, EMCY: the drive's business, not a sample
+    if (auto t = tilt_.decode(f); t && h.tilt) h.tilt(t->sample);
   };
   raw.camera = [&](const CameraFrame& f) {
     ++frames_;
@@ -133,7 +136,8 @@ SensorReplayCounters SensorReplay::counters() const {
   c.scans = scans_.scans();
   c.lostScans = scans_.lostScans();
   c.badScans = scans_.badScans();
-  c.tiltSamples = tilt_.counters().positions;
+  c.tiltSamples = tilt_.samples();
+  c.badTpdos = tilt_.badPdos();
   c.frames = frames_;
   return c;
 }

@@ -11,7 +11,8 @@
 #include "fusedet/drivers/lms291/scan_decoder.h"
 #include "fusedet/drivers/lms291/telegram.h"
 #include "fusedet/drivers/log/recorder.h"
-#include "fusedet/drivers/log/tilt_decoder.h"
+#include "fusedet/drivers/log/candump.h"
+#include "nod_simulation.h"
 #include "fusedet/fusion/frame_encode.h"
 #include "fusedet/fusion/kitti.h"
 #include "fusedet/fusion/synth_scene.h"
@@ -55,7 +56,14 @@ struct Event {
 
 }  // namespace
 
-SynthRig::SynthRig() { nod = NodProfile{-3 * kDeg, 16 * kDeg, 15 * kDeg, 150 * kDeg}; }
+SynthRig::SynthRig() {
+  tilt.node = 5;
+  tilt.minDeg = -3;
+  tilt.maxDeg = 16;
+  tilt.speedDegS = 15;
+  tilt.units = {4096, 50.0, 0};
+  tilt.heartbeatMs = 100;
+}
 
 std::string SynthRig::configYaml() const {
   const Eigen::Vector3d ypr = laserToCamera.linear().eulerAngles(2, 1, 0);  // R = Rz(yaw) Ry(pitch) Rx(roll)
@@ -66,10 +74,10 @@ std::string SynthRig::configYaml() const {
     << "laser:\n  device: synthetic\n  baud: " << baud << "\n  angle_deg: " << angleDeg
     << "\n  resolution_deg: " << num(resolutionCdeg / 100.0) << "\n  remission: true\n  range_unit: cm\n"
     << "  remission_full_scale: " << num(remissionFullScale) << "\n"
-    << "tilt:\n  interface: can0\n  node_id: " << nodeId << "\n  min_deg: " << num(nod.min / kDeg)
-    << "\n  max_deg: " << num(nod.max / kDeg) << "\n  speed_deg_s: " << num(nod.speed / kDeg)
-    << "\n  counts_per_rev: " << countsPerRev << "\n  gear_ratio: " << num(gearRatio)
-    << "\n  zero_offset_counts: 0\n  heartbeat_ms: " << std::lround(heartbeatS * 1000) << "\n"
+    << "tilt:\n  interface: can0\n  node_id: " << tilt.node << "\n  min_deg: " << num(tilt.minDeg)
+    << "\n  max_deg: " << num(tilt.maxDeg) << "\n  speed_deg_s: " << num(tilt.speedDegS)
+    << "\n  counts_per_rev: " << tilt.units.countsPerRev << "\n  gear_ratio: " << num(tilt.units.gearRatio)
+    << "\n  zero_offset_counts: " << tilt.units.zeroOffsetCounts << "\n  heartbeat_ms: " << tilt.heartbeatMs << "\n"
     << "camera:\n  device: synthetic\n  format: yuyv\n  width: " << camera.width << "\n  height: " << camera.height
     << "\n  fps: " << std::max(1L, std::lround(cameraFps)) << "\n  calibration: log:camera.yaml\n"
     << "fusion:\n  laser_to_camera:\n    rotation_rpy_deg: [" << num(ypr[2] / kDeg) << ", " << num(ypr[1] / kDeg) << ", "
@@ -131,42 +139,90 @@ SynthReport synthesizeLog(const SynthOptions& options, const std::filesystem::pa
     }
   }
 
-  const double stroke = rig.nod.halfPeriod();
-  report.strokeS = stroke;
-  report.seconds = stroke * options.frames;
-  const std::int64_t t0 = options.start.ns;
+  // The tilt unit: the live drive against the motor simulator. Every frame on the bus, the
+  // motor's actual position at every 1 ms step, and when each move reached its target.
+  namespace canopen = drivers::canopen;
+  std::vector<canopen::CanFrame> can;
+  std::vector<std::int64_t> pathNs;
+  std::vector<double> pathRad;
+  std::vector<std::int64_t> reached;  // moves: 1 = at the nearer end, 1 + k = sweep k done
+  canopen::sim::NodSimulationOptions nod;
+  nod.drive = rig.tilt;
+  nod.sweeps = options.frames;
+  nod.startSeconds = static_cast<double>(options.start.ns) * 1e-9;
+  nod.onFrame = [&](const canopen::CanFrame& f) { can.push_back(f); };
+  nod.onStep = [&](Stamp now, std::int32_t counts, const canopen::TiltDriveCounters& c) {
+    pathNs.push_back(now.ns);
+    pathRad.push_back(rig.tilt.units.toRad(counts));
+    while (reached.size() < c.moves) reached.push_back(now.ns);
+  };
+  const auto simulated = canopen::sim::runNodSimulation(nod);
+  if (!simulated) throw std::runtime_error("synth-log: tilt simulation: " + simulated.error().message());
+  if (reached.size() < static_cast<std::size_t>(options.frames) + 1 || can.empty())
+    throw std::runtime_error("synth-log: tilt simulation ended before " + std::to_string(options.frames) + " sweeps");
+  report.canFrames = can.size();
+  report.tpdos = simulated->motor.tpdos;
+  report.sdoRequests = simulated->motor.sdoRequests;
+  // The motor's angle at t, interpolated between its 1 ms steps.
+  auto tiltAt = [&](std::int64_t t) {
+    const auto it = std::upper_bound(pathNs.begin(), pathNs.end(), t);
+    if (it == pathNs.begin()) return pathRad.front();
+    if (it == pathNs.end()) return pathRad.back();
+    const auto i = static_cast<std::size_t>(it - pathNs.begin());
+    const double w = static_cast<double>(t - pathNs[i - 1]) / static_cast<double>(pathNs[i] - pathNs[i - 1]);
+    return pathRad[i - 1] + w * (pathRad[i] - pathRad[i - 1]);
+  };
+  // Stroke k starts when the motor leaves the end it reached (after the set-point handshake):
+  // scans at rest before that belong to the sweep that ended there, as SweepAssembler splits.
+  for (int k = 0; k < options.frames; ++k) {
+    const std::int64_t at = reached[static_cast<std::size_t>(k)];
+    const double rest = tiltAt(at);
+    std::size_t i = static_cast<std::size_t>(std::lower_bound(pathNs.begin(), pathNs.end(), at) - pathNs.begin());
+    while (i + 1 < pathNs.size() && pathRad[i] == rest) ++i;
+    report.strokeStart.push_back(Stamp{i > 0 ? pathNs[i - 1] : pathNs[i]});
+  }
+  report.end = Stamp{reached[static_cast<std::size_t>(options.frames)]};
+  const std::int64_t t0 = report.strokeStart.front().ns;  // laser and camera start here
+  report.strokeS = static_cast<double>(report.end.ns - t0) * 1e-9 / options.frames;
+  report.startupS = static_cast<double>(t0 - can.front().stamp.ns) * 1e-9;
+  report.seconds = static_cast<double>(can.back().stamp.ns - can.front().stamp.ns) * 1e-9;
   auto ns = [](double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); };
 
   drivers::mcap::WriterOptions writerOptions;
   logs::Recorder rec(out, writerOptions, std::chrono::milliseconds(0));
   rec.setRig(rig.configYaml(), rig.cameraYaml());
-  std::string frames;
+  std::string frames, starts;
   for (const std::string& id : report.frameIds) frames += (frames.empty() ? "" : " ") + id;
+  for (const Stamp& t : report.strokeStart) starts += (starts.empty() ? "" : " ") + std::to_string(t.ns);
   rec.addMetadata(logs::kRecordingMetadata,
-                  {{"source", "synth-log"}, {"scene", report.scene}, {"frames", frames}, {"stroke_s", num(stroke)},
-                   {"start_ns", std::to_string(t0)}, {"tolerance_deg", num(options.toleranceDeg)},
-                   {"note", "one nodding stroke per frame; the scene stands still during a stroke"}});
+                  {{"source", "synth-log"}, {"scene", report.scene}, {"frames", frames}, {"stroke_s", num(report.strokeS)},
+                   {"start_ns", std::to_string(t0)}, {"stroke_starts_ns", starts}, {"end_ns", std::to_string(report.end.ns)},
+                   {"tolerance_deg", num(options.toleranceDeg)},
+                   {"note", "one nodding sweep per frame; the scene stands still during a sweep; CAN traffic of "
+                            "fusedet's TiltDrive against the CiA 402 motor simulator (start-up before start_ns)"}});
   {
-    logs::TransformMessage tf{Stamp{t0}, "laser_base", "camera", {}, {}};
+    logs::TransformMessage tf{Stamp{can.front().stamp.ns}, "laser_base", "camera", {}, {}};
     const Eigen::Isometry3d camInBase = rig.laserToCamera.inverse();
     const Eigen::Quaterniond q(camInBase.linear());
     tf.translation = {camInBase.translation().x(), camInBase.translation().y(), camInBase.translation().z()};
     tf.rotation = {q.x(), q.y(), q.z(), q.w()};
     rec.record(tf);
   }
+  // CAN traffic of the start-up, before any laser or camera message.
+  std::size_t canIndex = 0;
+  for (; canIndex < can.size() && can[canIndex].stamp.ns < t0; ++canIndex) rec.record(logs::toCanMessage(can[canIndex], "can0"));
 
   const lms::Variant variant{rig.angleDeg, rig.resolutionCdeg};
   const int beams = variant.beams();
   const double scanPeriod = 1.0 / lms::kMirrorHz;
   const double beamS = (rig.resolutionCdeg / 100.0 / 360.0) / lms::kMirrorHz;
   const std::int64_t byteNs = ns(lms::byteSeconds(rig.baud));
-  const logs::TiltDecoderConfig units{rig.nodeId, rig.countsPerRev, rig.gearRatio, 0};
   const Eigen::Vector3d axis(0, 1, 0);  // SweepConfig's default tilt axis
 
-  std::int64_t scanIndex = 0, syncIndex = 0, cameraIndex = 0;
+  std::int64_t scanIndex = 0, cameraIndex = 0;
   for (int k = 0; k < options.frames; ++k) {
-    const double end = stroke * (k + 1);
-    report.strokeStart.push_back(Stamp{t0 + ns(stroke * k)});
+    const std::int64_t endNs = k + 1 < options.frames ? report.strokeStart[static_cast<std::size_t>(k) + 1].ns : report.end.ns;
+    const double end = static_cast<double>(endNs - t0) * 1e-9;  // seconds after t0
     std::vector<Event> events;
     // Laser: scans starting inside this stroke.
     for (; scanIndex * scanPeriod < end; ++scanIndex) {
@@ -177,7 +233,7 @@ SynthReport synthesizeLog(const SynthOptions& options, const std::filesystem::pa
       block.countWord.count = beams;
       block.countWord.unit = lms::Unit::kCm;
       for (int b = 0; b < beams; ++b) {
-        const double tilt = rig.nod.angleAt(ts + b * beamS);
+        const double tilt = tiltAt(t0 + ns(ts + b * beamS));
         const double a = variant.startDeg() * kDeg + b * (rig.resolutionCdeg / 100.0) * kDeg;
         const Eigen::Matrix3d r = Eigen::AngleAxisd(tilt, axis).toRotationMatrix();
         const Eigen::Vector3d o = r * rig.tiltAxisOffset;
@@ -213,25 +269,10 @@ SynthReport synthesizeLog(const SynthOptions& options, const std::filesystem::pa
         events.push_back({c.stamp.ns, 0, [c](logs::Recorder& r) { r.record(c); }});
       }
     }
-    // CAN: SYNC, the TPDO answering it, heartbeats.
-    for (; syncIndex * rig.syncPeriodS < end; ++syncIndex) {
-      const double ts = syncIndex * rig.syncPeriodS;
-      const auto counts = static_cast<std::uint32_t>(units.radToCounts(rig.nod.angleAt(ts)));
-      const logs::CanMessage sync{Stamp{t0 + ns(ts)}, "can0", 0x080, false, false, false, {}};
-      const logs::CanMessage tpdo{Stamp{t0 + ns(ts + rig.tpdoDelayS)}, "can0", 0x180u + static_cast<std::uint32_t>(rig.nodeId),
-                                  false, false, false,
-                                  {static_cast<std::uint8_t>(counts), static_cast<std::uint8_t>(counts >> 8),
-                                   static_cast<std::uint8_t>(counts >> 16), static_cast<std::uint8_t>(counts >> 24)}};
-      events.push_back({sync.stamp.ns, 1, [sync](logs::Recorder& r) { r.record(sync); }});
-      events.push_back({tpdo.stamp.ns, 1, [tpdo](logs::Recorder& r) { r.record(tpdo); }});
-      report.canFrames += 2;
-      const long perHeartbeat = std::lround(rig.heartbeatS / rig.syncPeriodS);
-      if (syncIndex % perHeartbeat == 0) {
-        const logs::CanMessage hb{Stamp{t0 + ns(ts + 2.5 * rig.tpdoDelayS)}, "can0", 0x700u + static_cast<std::uint32_t>(rig.nodeId),
-                                  false, false, false, {0x05}};
-        events.push_back({hb.stamp.ns, 1, [hb](logs::Recorder& r) { r.record(hb); }});
-        ++report.canFrames;
-      }
+    // CAN: the simulated bus traffic of this stroke.
+    for (; canIndex < can.size() && can[canIndex].stamp.ns < endNs; ++canIndex) {
+      const logs::CanMessage m = logs::toCanMessage(can[canIndex], "can0");
+      events.push_back({m.stamp.ns, 1, [m](logs::Recorder& r) { r.record(m); }});
     }
     // Camera.
     for (; cameraIndex / options.cameraFps < end; ++cameraIndex) {
@@ -249,6 +290,8 @@ SynthReport synthesizeLog(const SynthOptions& options, const std::filesystem::pa
     std::stable_sort(events.begin(), events.end(), [](const Event& a, const Event& b) { return a.t < b.t; });
     for (const Event& e : events) e.write(rec);
   }
+  // The stop sequence after the last sweep.
+  for (; canIndex < can.size(); ++canIndex) rec.record(logs::toCanMessage(can[canIndex], "can0"));
   rec.close();
   return report;
 }

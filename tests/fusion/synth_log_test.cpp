@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -77,8 +78,10 @@ Replayed replayAndFuse(const fs::path& log) {
   std::vector<std::string> ids;
   std::istringstream frames(rec->entries.at("frames"));
   for (std::string id; frames >> id;) ids.push_back(id);
-  const double strokeS = std::stod(rec->entries.at("stroke_s"));
-  const std::int64_t startNs = std::stoll(rec->entries.at("start_ns"));
+  std::vector<std::int64_t> strokeStarts;  // when the motor left one end for each frame's sweep
+  std::istringstream starts(rec->entries.at("stroke_starts_ns"));
+  for (std::int64_t t; starts >> t;) strokeStarts.push_back(t);
+  if (strokeStarts.size() != ids.size()) throw std::runtime_error("stroke_starts_ns and frames differ in length");
 
   logs::SensorReplay replay(log, daemon::sensorReplayConfig(config));
   SweepAssembler sweeps(daemon::sweepConfig(config));
@@ -94,8 +97,9 @@ Replayed replayAndFuse(const fs::path& log) {
       if (!frame) continue;
       auto bgr = decodeCameraFrame(*frame);
       if (!bgr) throw std::runtime_error(bgr.error().message());
-      const auto stroke = static_cast<std::size_t>((s.middle().ns - startNs) * 1e-9 / strokeS);
-      out.stacks.push_back({stroke < ids.size() ? ids[stroke] : "?", fuser.fuse(*bgr, s), std::move(s)});
+      const auto after = std::upper_bound(strokeStarts.begin(), strokeStarts.end(), s.middle().ns);
+      const std::string id = after == strokeStarts.begin() ? "?" : ids[static_cast<std::size_t>(after - strokeStarts.begin() - 1)];
+      out.stacks.push_back({id, fuser.fuse(*bgr, s), std::move(s)});
     }
   };
   logs::SensorReplay::Handlers h;
@@ -130,8 +134,9 @@ SynthOptions kittiOptions() {
 // (0.16 deg each) that both measured.
 //
 // Tolerance and why. A synthetic beam takes the range of the first Velodyne return within 0.4 deg
-// of its ray (the Velodyne's rings are ~0.4 deg apart); ranges are quantised to 1 cm and the tilt
-// reaches the driver 0.2 ms late (TPDO after SYNC). On surfaces seen face-on this changes the
+// of its ray (the Velodyne's rings are ~0.4 deg apart); ranges are quantised to 1 cm, the beam's
+// tilt is the simulated motor's position (1 ms steps, interpolated) and replay interpolates the
+// 100 Hz TPDO1 samples the drive decodes (their counts quantise the angle to 0.002 deg). On surfaces seen face-on this changes the
 // camera distance by millimetres to centimetres. But the z-buffer keeps the nearest of the points
 // that fall into a cell, and a cell holds many Velodyne points and at most one synthetic one: on
 // the ground seen at grazing angles a cell spans d^2 / h * 2.8 mrad of depth (0.16 m at 10 m,
@@ -193,6 +198,77 @@ TEST(SynthLog, KittiReplayMatchesDirectImportWithinResamplingError) {
     EXPECT_LE(percentile(nearRel, 0.5), 0.006);
     EXPECT_GE(share(nearRel, 0.05), 0.85);
   }
+}
+
+// The CAN traffic is what the live drive and a CiA 402 drive exchange, read here with the
+// protocol's numbers written out (no fusedet decoder): NMT reset -> boot-up -> SDO configuration of
+// TPDO1 (position 0x6064 + statusword 0x6041) -> NMT start -> SYNC/TPDO1/heartbeats while
+// nodding, all before the first laser byte, NMT pre-operational at the end; the TPDO angles nod between the configured ends.
+TEST(SynthLog, CanTrafficIsTheDriveAgainstTheMotorSimulator) {
+  SynthOptions o;
+  o.frames = 2;
+  const fs::path log = cachedLog("procedural-2-frames.mcap", o);
+  logs::LogSource source(log);
+  std::map<std::string, int> n;
+  std::int64_t firstSerial = -1, configured = -1;
+  bool mappedPosition = false, mappedStatus = false;
+  double minDeg = 1e9, maxDeg = -1e9;
+  std::vector<int> directions;  // +1 / -1 per run of rising / falling TPDO angles
+  double lastDeg = 0;
+  bool haveLast = false;
+  logs::LogSource::Handlers h;
+  h.serial = [&](const logs::SerialChunk& c) {
+    if (firstSerial < 0) firstSerial = c.stamp.ns;
+  };
+  h.can = [&](const logs::CanMessage& m) {
+    const auto& d = m.data;
+    auto le = [&](std::size_t at, int bytes) {
+      std::uint32_t v = 0;
+      for (int i = bytes - 1; i >= 0; --i) v = v << 8 | d[at + static_cast<std::size_t>(i)];
+      return v;
+    };
+    if (m.id == 0x000 && d.size() == 2 && d[1] == 5) ++n[d[0] == 0x81 ? "nmt reset" : d[0] == 0x01 ? "nmt start" : d[0] == 0x80 ? "nmt pre-operational" : "nmt other"];
+    else if (m.id == 0x705 && d.size() == 1) ++n[d[0] == 0x00 ? "boot-up" : d[0] == 0x05 ? "heartbeat operational" : "heartbeat other"];
+    else if (m.id == 0x080 && d.empty()) ++n["sync"];
+    else if (m.id == 0x605 && d.size() == 8) {
+      ++n["sdo request"];
+      if ((d[0] & 0xE0) == 0x20 && le(1, 2) == 0x1A00 && d[3] == 1 && le(4, 4) == 0x60640020) mappedPosition = true;
+      if ((d[0] & 0xE0) == 0x20 && le(1, 2) == 0x1A00 && d[3] == 2 && le(4, 4) == 0x60410010) mappedStatus = true;
+    } else if (m.id == 0x585 && d.size() == 8) ++n["sdo response"];
+    else if (m.id == 0x185) {
+      ASSERT_EQ(d.size(), 6u) << "TPDO1 = int32 position + uint16 statusword";
+      ++n["tpdo1"];
+      if (configured < 0) configured = m.stamp.ns;
+      const double deg = static_cast<std::int32_t>(le(0, 4)) * 360.0 / (4096 * 50);  // config: 4096 counts/rev, gear 50
+      minDeg = std::min(minDeg, deg);
+      maxDeg = std::max(maxDeg, deg);
+      if (haveLast && std::abs(deg - lastDeg) > 1e-3) {
+        const int dir = deg > lastDeg ? 1 : -1;
+        if (directions.empty() || directions.back() != dir) directions.push_back(dir);
+      }
+      lastDeg = deg, haveLast = true;
+    } else ++n["other " + std::to_string(m.id)];
+  };
+  while (source.step(h)) {
+  }
+  for (const auto& [k, v] : n) std::printf("%s: %d\n", k.c_str(), v);
+  EXPECT_EQ(n["nmt reset"], 1);
+  EXPECT_EQ(n["boot-up"], 1);
+  EXPECT_EQ(n["nmt start"], 1);
+  EXPECT_EQ(n["nmt pre-operational"], 1);  // the drive's stop() after the last sweep
+  EXPECT_TRUE(mappedPosition && mappedStatus) << "SDO writes of the TPDO1 mapping";
+  EXPECT_GT(n["sdo request"], 15);
+  EXPECT_EQ(n["sdo request"], n["sdo response"]);  // every request answered (no fault in this log)
+  EXPECT_GT(n["sync"], 250);  // 100 Hz over > 3 s
+  EXPECT_NEAR(n["tpdo1"], n["sync"], 5);  // one TPDO1 per SYNC once operational
+  EXPECT_GT(n["heartbeat operational"], 25);
+  EXPECT_EQ(n["heartbeat other"] + n["nmt other"], 0);
+  EXPECT_NEAR(minDeg, -3.0, 0.01);  // tilt: min_deg / max_deg of the log's rig
+  EXPECT_NEAR(maxDeg, 16.0, 0.01);
+  // start at 0, down to the nearer end (-3), then one sweep per frame: down, up, down
+  EXPECT_EQ(directions, (std::vector<int>{-1, 1, -1}));
+  ASSERT_GE(firstSerial, 0);
+  EXPECT_LT(configured, firstSerial) << "the laser starts after the drive's start-up";
 }
 
 // The procedural fallback: points of the replayed sweeps lie on the scene's known surfaces.

@@ -1,4 +1,4 @@
-// Parts of synth-log: nodding profile, ray casting into a point cloud, YUYV encoding (checked
+// Parts of synth-log: ray casting into a point cloud, YUYV encoding (checked
 // through the independent OpenCV decoder decodeCameraFrame uses), the procedural scene.
 
 #include <gtest/gtest.h>
@@ -9,33 +9,11 @@
 
 #include "fusedet/fusion/frame_decode.h"
 #include "fusedet/fusion/frame_encode.h"
-#include "fusedet/fusion/nod_profile.h"
 #include "fusedet/fusion/point_ray_caster.h"
 #include "fusedet/fusion/synth_scene.h"
 
 using namespace fusedet;
 using namespace fusedet::fusion;
-
-TEST(NodProfile, TrapezoidBetweenLimits) {
-  const double deg = M_PI / 180;
-  const NodProfile p{-3 * deg, 16 * deg, 15 * deg, 150 * deg};
-  // stroke = 19/15 s cruise-equivalent + v/a = 1.2667 + 0.1
-  EXPECT_NEAR(p.halfPeriod(), 19.0 / 15 + 0.1, 1e-9);
-  EXPECT_NEAR(p.angleAt(0), p.min, 1e-12);
-  EXPECT_NEAR(p.angleAt(p.halfPeriod()), p.max, 1e-9);
-  EXPECT_NEAR(p.angleAt(2 * p.halfPeriod()), p.min, 1e-9);
-  double last = p.angleAt(0);
-  for (double t = 0.001; t < 4 * p.halfPeriod(); t += 0.001) {
-    const double a = p.angleAt(t);
-    EXPECT_LE(std::abs(a - last), p.speed * 0.001 + 1e-12) << t;  // never faster than the cruise speed
-    EXPECT_GE(a, p.min - 1e-12);
-    EXPECT_LE(a, p.max + 1e-12);
-    EXPECT_NEAR((a - last) / 0.001, p.velocityAt(t - 0.0005), 0.08) << t;  // velocity = derivative
-    last = a;
-  }
-  const NodProfile shortStroke{0, 0.01, 1, 1};  // too short to reach cruise speed: triangle
-  EXPECT_NEAR(shortStroke.halfPeriod(), 2 * std::sqrt(0.01), 1e-9);
-}
 
 TEST(PointRayCaster, FirstSurfaceWithinTolerance) {
   Sweep cloud;

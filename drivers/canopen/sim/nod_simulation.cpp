@@ -40,12 +40,15 @@ Result<NodSimulationReport> runNodSimulation(const NodSimulationOptions& o,
   InProcessBus::Endpoint& masterBus = net.connect();
   InProcessBus::Endpoint& motorBus = net.connect();
   // The log takes every frame either node sends, in the order they went on the bus.
-  masterBus.setFrameHook([&](const CanFrame& f, FrameDirection d) {
-    if (d == FrameDirection::kTx) log.write(f);
-  });
-  motorBus.setFrameHook([&](const CanFrame& f, FrameDirection d) {
-    if (d == FrameDirection::kTx) log.write(f);
-  });
+  std::uint64_t frames = 0;
+  auto onBus = [&](const CanFrame& f, FrameDirection d) {
+    if (d != FrameDirection::kTx) return;
+    ++frames;
+    log.write(f);  // no-op without a log file
+    if (o.onFrame) o.onFrame(f);
+  };
+  masterBus.setFrameHook(onBus);
+  motorBus.setFrameHook(onBus);
   MotorSimOptions mo;
   mo.node = o.drive.node;
   MotorSimulator motor(motorBus, mo);
@@ -70,6 +73,7 @@ Result<NodSimulationReport> runNodSimulation(const NodSimulationOptions& o,
   };
   const bool done = net.runUntil(
       [&] {
+        if (o.onStep) o.onStep(net.now(), motor.position(), drive.counters());
         if (!injected && net.now() - start >= static_cast<std::int64_t>(o.faultAtSeconds * 1e9)) {
           injected = true;
           inject();
@@ -78,11 +82,24 @@ Result<NodSimulationReport> runNodSimulation(const NodSimulationOptions& o,
       },
       std::chrono::nanoseconds(static_cast<std::int64_t>(limit * 1e9)));
   drive.stop();
-  (void)net.runUntil([&] { return drive.stopped(); }, std::chrono::seconds(2));
-  net.advance(std::chrono::milliseconds(20));  // deliver what is still in flight
+  auto stepped = [&] {
+    if (o.onStep) o.onStep(net.now(), motor.position(), drive.counters());
+  };
+  (void)net.runUntil(
+      [&] {
+        stepped();
+        return drive.stopped();
+      },
+      std::chrono::seconds(2));
+  (void)net.runUntil(  // deliver what is still in flight
+      [&, end = net.now() + std::int64_t{20'000'000}] {
+        stepped();
+        return net.now() >= end;
+      },
+      std::chrono::seconds(1));
   NodSimulationReport report;
   report.seconds = static_cast<double>(net.now() - start) * 1e-9;
-  report.frames = log.lines();
+  report.frames = frames;
   report.drive = drive.counters();
   report.motor = motor.counters();
   if (auto r = log.close(); !r) return r.error();

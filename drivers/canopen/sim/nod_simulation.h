@@ -26,11 +26,18 @@ struct NodSimulationOptions {
   double faultAtSeconds = 5.0;    // after the start
   double limitSeconds = 0;        // give up after this much simulated time (0 = from the sweeps)
   TiltDrive::EventHandler onEvent;  // start-up, sweeps, faults, recoveries
+  // Every frame as it goes on the bus (either node's transmission), in bus order: what a
+  // listening socket (candump, `fusedet record`) sees.
+  std::function<void(const CanFrame&)> onFrame;
+  // Once per simulated step (1 ms), after it: the motor's actual position [counts] (what an
+  // encoder on the tilt axis reads; synth-log points its virtual laser with it) and the drive's
+  // counters (moves = targets reached so far).
+  std::function<void(Stamp now, std::int32_t motorCounts, const TiltDriveCounters& drive)> onStep;
 };
 
 struct NodSimulationReport {
   double seconds = 0;             // simulated time used
-  std::uint64_t frames = 0;       // lines in the log = frames on the bus
+  std::uint64_t frames = 0;       // frames on the bus (= lines in the log)
   TiltDriveCounters drive;
   MotorSimCounters motor;
 };

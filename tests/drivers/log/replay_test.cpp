@@ -65,14 +65,13 @@ Sample writeLog(const std::string& name, mcap::WriterOptions o = {}) {
                              {bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(at + n)}});
     }
   }
-  const TiltDecoderConfig tilt;
   for (int i = 0; i < 40; ++i) {
     rec.record(CanMessage{Stamp{kT0 + i * 10'000'000}, "can0", 0x080, false, false, false, {}});
-    const std::int32_t counts = tilt.radToCounts(0.01 * i);
-    const auto u = static_cast<std::uint32_t>(counts);
+    // TPDO1 as the drive maps it: position counts (default units: 4096 x 50 counts per turn) + statusword 0x1637
+    const auto u = static_cast<std::uint32_t>(std::lround(0.01 * i * 4096 * 50 / (2 * M_PI)));
     rec.record(CanMessage{Stamp{kT0 + i * 10'000'000 + 300'000}, "can0", 0x185, false, false, false,
                           {static_cast<std::uint8_t>(u), static_cast<std::uint8_t>(u >> 8), static_cast<std::uint8_t>(u >> 16),
-                           static_cast<std::uint8_t>(u >> 24)}});
+                           static_cast<std::uint8_t>(u >> 24), 0x37, 0x16}});
   }
   for (int i = 0; i < 3; ++i) {
     CameraFrame f;
@@ -220,30 +219,40 @@ TEST(Replay, MissingOrForeignFileIsAnError) {
   fs::remove(p);
 }
 
-TEST(TiltDecoder, CountsUnitsAndBadFrames) {
-  TiltDecoderConfig c;
-  c.nodeId = 3;
-  c.countsPerRev = 1000;
-  c.gearRatio = 2;
-  c.zeroOffsetCounts = 100;
-  TiltDecoder d(c);
-  // 600 counts: (600 - 100) / 2000 rev = pi/2 rad
-  auto s = d.decode(CanMessage{Stamp{5}, "can0", 0x183, false, false, false, {0x58, 0x02, 0, 0}});
-  ASSERT_TRUE(s);
-  EXPECT_NEAR(s->angle, M_PI / 2, 1e-12);
-  // negative counts (two's complement): -400 -> -pi/2
-  s = d.decode(CanMessage{Stamp{1'000'000'005}, "can0", 0x183, false, false, false, {0x70, 0xFE, 0xFF, 0xFF}});
-  ASSERT_TRUE(s);
-  EXPECT_NEAR(s->angle, -M_PI / 2, 1e-12);
-  EXPECT_NEAR(s->velocity, -M_PI, 1e-9);
-  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x183, false, false, false, {1, 2}}));      // short
-  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x185, false, false, false, {1, 2, 3, 4}}));  // other node
-  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x703, false, false, false, {0x05}}));
-  EXPECT_FALSE(d.decode(CanMessage{Stamp{6}, "can0", 0x080, false, false, false, {}}));
-  EXPECT_EQ(d.counters().positions, 2u);
-  EXPECT_EQ(d.counters().malformed, 1u);
-  EXPECT_EQ(d.counters().heartbeats, 1u);
-  EXPECT_EQ(d.counters().lastState, 0x05);
-  EXPECT_EQ(d.counters().syncs, 1u);
-  EXPECT_EQ(c.radToCounts(M_PI / 2), 600);
+// Replay decodes TPDO1 with the live drive's decoder and the log's tilt units; SYNC,
+// heartbeats, SDO traffic and other nodes' frames give no samples, short TPDOs are counted.
+TEST(Replay, TiltTpdoUnitsOtherFramesAndShortPdos) {
+  const fs::path p = fs::temp_directory_path() / ("fusedet_replay_tpdo_" + std::to_string(::getpid()) + ".mcap");
+  {
+    Recorder rec(p, {}, std::chrono::milliseconds(0));
+    auto can = [&](std::int64_t t, std::uint32_t id, std::vector<std::uint8_t> d) {
+      rec.record(CanMessage{Stamp{t}, "can0", id, false, false, false, std::move(d)});
+    };
+    can(1'000, 0x000, {0x81, 3});                               // NMT reset node 3
+    can(2'000, 0x703, {0x00});                                  // boot-up
+    can(3'000, 0x603, {0x40, 0x00, 0x10, 0, 0, 0, 0, 0});       // SDO request
+    can(4'000, 0x583, {0x43, 0x00, 0x10, 0, 0x92, 0x01, 0, 0});  // SDO response
+    can(5'000, 0x080, {});                                      // SYNC
+    can(5'100, 0x183, {0x58, 0x02, 0, 0, 0x37, 0x16});          // 600 counts
+    can(6'000, 0x185, {1, 2, 3, 4, 5, 6});                      // another node's TPDO1
+    can(250'005'100, 0x183, {0x70, 0xFE, 0xFF, 0xFF, 0x37, 0x16});  // -400 counts
+    can(250'006'000, 0x183, {1, 2, 3, 4});                    // 4 bytes: no statusword
+    rec.close();
+  }
+  SensorReplayConfig c;
+  c.tilt.node = 3;
+  c.tilt.units = {1000, 2.0, 100};  // (counts - 100) / 2000 rev
+  SensorReplay r(p, c);
+  std::vector<TiltSample> samples;
+  SensorReplay::Handlers h;
+  h.tilt = [&](const TiltSample& t) { samples.push_back(t); };
+  r.run(h);
+  ASSERT_EQ(samples.size(), 2u);
+  EXPECT_EQ(samples[0].stamp.ns, 5'100);
+  EXPECT_NEAR(samples[0].angle, M_PI / 2, 1e-12);   // (600 - 100) / 2000 rev
+  EXPECT_NEAR(samples[1].angle, -M_PI / 2, 1e-12);  // (-400 - 100) / 2000 rev
+  EXPECT_NEAR(samples[1].velocity, -4 * M_PI, 1e-9);  // -pi rad in 0.25 s
+  EXPECT_EQ(r.counters().tiltSamples, 2u);
+  EXPECT_EQ(r.counters().badTpdos, 1u);
+  fs::remove(p);
 }

@@ -14,8 +14,7 @@
 namespace fusedet::daemon {
 
 drivers::lms291::Lms291Config laserConfig(const Config& c);         // laser: device, baud, variant, remission, unit
-drivers::logs::TiltDecoderConfig tiltUnits(const Config& c);         // tilt: node id, counts/rev, gear, zero offset
-drivers::logs::SensorReplayConfig sensorReplayConfig(const Config& c);
+drivers::logs::SensorReplayConfig sensorReplayConfig(const Config& c);  // laser + tilt (tiltDriveConfigFrom)
 fusion::SweepConfig sweepConfig(const Config& c);                   // fusion: tilt axis offset, window; laser: remission scale
 Eigen::Isometry3d laserToCamera(const Config& c);                   // fusion.laser_to_camera
 drivers::v4l2::CameraConfig cameraConfig(const Config& c);          // camera: device, format, size, fps, buffers, controls

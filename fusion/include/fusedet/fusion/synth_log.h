@@ -6,18 +6,24 @@
 // on a nodding unit driven by a CiA 402 motor (CAN node 5), and the camera. For KITTI the laser
 // base frame is the Velodyne frame and the camera is KITTI's rectified colour camera 2, so
 // `fusion.laser_to_camera` is KITTI's velo -> cam2 transform.
-// - Each KITTI frame is one stroke of the nodding unit (min -> max or back); the scene is taken
-//   as standing still during the stroke (a time lapse: strokes take ~1.4 s, KITTI frames are
-//   0.3 s apart).
-// - Every beam: time = scan start + beam x 1/(360 x 75) s (the mirror), tilt from the motion
-//   profile at that time, direction from scan angle and tilt (SweepAssembler's geometry);
+// - The tilt unit: canopen::TiltDrive (the live master) and issue 11's CiA 402 motor simulator
+//   on the in-process bus in simulated time (sim::runNodSimulation): NMT reset and boot-up, SDO
+//   configuration (TPDO1 = position + statusword, profile position mode, heartbeat), NMT start,
+//   enable, a move to the nearer end, then one sweep per frame; SYNC every 10 ms, TPDO1 answers,
+//   heartbeats, the set-point SDO handshakes, and the stop sequence at the end. Every frame either
+//   node sent goes into the log at its bus time.
+// - Each KITTI frame is one sweep of the nodding unit (min -> max or back); the scene is taken
+//   as standing still during the sweep (a time lapse: sweeps take ~1.5 s, KITTI frames are
+//   0.3 s apart). Laser and camera start when the first sweep starts (before it, during the
+//   drive's start-up, the log holds CAN traffic only).
+// - Every beam: time = scan start + beam x 1/(360 x 75) s (the mirror), tilt = the simulated
+//   motor's actual position at that time (1 ms steps, interpolated), direction from scan angle
+//   and tilt (SweepAssembler's geometry);
 //   range and remission from the nearest Velodyne return along that ray (PointRayCaster,
 //   angular tolerance `toleranceDeg`), quantised to cm and remission x 1000.
 // - Telegram bytes: lms291::encode of F5 telegrams, one per mirror rotation (75 Hz), sent from
 //   the scan's start time at 500 kbaud (10 bits/byte), read in 64-byte pieces stamped when their
 //   last byte arrived (what the driver's stamp model inverts).
-// - CAN: SYNC every 10 ms, TPDO1 (position actual value, counts) 0.2 ms after each SYNC with the
-//   position sampled at the SYNC, heartbeat (operational) every 100 ms.
 // - Camera: YUYV frames at `cameraFps` showing the KITTI image of the stroke in progress.
 // The rig is written as metadata "fusedet.config" (config.yaml + camera.yaml): replaying the log
 // with that configuration reproduces the geometry used here.
@@ -28,7 +34,7 @@
 
 #include "fusedet/core/stamp.h"
 #include "fusedet/fusion/camera_model.h"
-#include "fusedet/fusion/nod_profile.h"
+#include "fusedet/drivers/canopen/tilt_drive.h"
 
 namespace fusedet::fusion {
 
@@ -46,10 +52,7 @@ struct SynthRig {
   int baud = 500000;
   int angleDeg = 100, resolutionCdeg = 100;
   double remissionFullScale = 1000;
-  NodProfile nod;  // set by the constructor: -3 .. 16 deg, 15 deg/s, 150 deg/s^2
-  int nodeId = 5, countsPerRev = 4096;
-  double gearRatio = 50;
-  double syncPeriodS = 0.010, tpdoDelayS = 0.0002, heartbeatS = 0.100;
+  drivers::canopen::TiltDriveConfig tilt;  // set by the constructor: node 5, -3 .. 16 deg at 15 deg/s
   Eigen::Vector3d tiltAxisOffset{0, 0, 0.05};
   CameraModel camera;
   Eigen::Isometry3d laserToCamera = Eigen::Isometry3d::Identity();
@@ -63,9 +66,12 @@ struct SynthRig {
 struct SynthReport {
   std::string scene;                  // "kitti <dir>" or "procedural"
   std::vector<std::string> frameIds;  // per stroke: the KITTI frame id (procedural: "procedural-N")
-  std::vector<Stamp> strokeStart;     // per stroke
-  double strokeS = 0;
+  std::vector<Stamp> strokeStart;     // per stroke: the motor leaves one end
+  Stamp end{};                        // the last stroke reached its end
+  double strokeS = 0;                 // mean period from one stroke's start to the next
+  double startupS = 0;                // first CAN frame -> first stroke (bring-up, move to the end)
   std::uint64_t scans = 0, beams = 0, hits = 0, serialBytes = 0, serialChunks = 0, canFrames = 0, cameraFrames = 0;
+  std::uint64_t tpdos = 0, sdoRequests = 0;  // the motor simulator's counters
   double seconds = 0;                 // log duration
   SynthRig rig;
 };

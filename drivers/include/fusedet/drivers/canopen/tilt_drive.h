@@ -23,6 +23,7 @@
 #include "fusedet/drivers/canopen/can_node.h"
 #include "fusedet/drivers/canopen/protocol.h"
 #include "fusedet/drivers/canopen/sdo_client.h"
+#include "fusedet/drivers/canopen/tilt_tpdo.h"
 #include "fusedet/drivers/canopen/tilt_units.h"
 #include "fusedet/drivers/messages.h"
 
@@ -138,6 +139,7 @@ class TiltDrive : public CanNode {
   FaultHandler onFault_;
   mutable std::recursive_mutex mutex_;  // SDO callbacks re-enter the drive
   SdoClient sdo_;
+  TiltTpdoDecoder tpdo_;  // TPDO1 -> TiltSample (shared with the log replay)
   TiltDriveCounters counters_;
 
   TiltPhase phase_ = TiltPhase::kIdle;
@@ -164,7 +166,6 @@ class TiltDrive : public CanNode {
   bool positioned_ = false;  // at one end: the next nod move is a full sweep
   int ackPolls_ = 0;
 
-  std::optional<TiltSample> lastSample_;
   EventHandler onEvent_;
   Stamp startedAt_{};
   bool everEnabled_ = false;

@@ -15,9 +15,9 @@ struct ChannelInfo {
   std::string topic, schema;
   std::uint64_t messages = 0;
   std::uint64_t first = 0, last = 0;  // log times [ns]
-  double medianPeriodS = 0;
+  double usualPeriodS = 0;
   double maxGapS = 0;
-  std::uint64_t gaps = 0;  // intervals longer than gapFactor x the median period
+  std::uint64_t gaps = 0;  // intervals longer than gapFactor x the usual period
 };
 
 struct LogInfo {
@@ -31,7 +31,8 @@ struct LogInfo {
   std::vector<std::string> problems;
 };
 
-// Reads every intact chunk once. gapFactor: an interval counts as a gap above gapFactor x median.
+// Reads every intact chunk once. gapFactor: an interval counts as a gap above gapFactor x the usual
+// period (the 90th percentile of the intervals: bursts do not make every pause a gap).
 LogInfo inspectLog(const mcap::McapReader& reader, double gapFactor = 3.0);
 // Human-readable report (what `fusedet log info` prints).
 std::string formatLogInfo(const LogInfo& info, const std::string& name);

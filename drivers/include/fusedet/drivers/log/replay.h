@@ -7,8 +7,8 @@
 // deliver identical messages in identical order (deterministic).
 //
 // SensorReplay feeds those raw streams into the live decoders: serial bytes into the LMS telegram
-// reader and lms291::ScanDecoder (the code Lms291 uses), CAN frames into the tilt decoder (position
-// TPDO -> TiltSample), camera buffers pass through as CameraFrame (decode with
+// reader and lms291::ScanDecoder (the code Lms291 uses), CAN frames into canopen::TiltTpdoDecoder
+// (the TPDO1 -> TiltSample rule TiltDrive uses), camera buffers pass through as CameraFrame (decode with
 // fusion::decodeCameraFrame, as live). What comes out is what the live drivers would have emitted.
 
 #include <atomic>
@@ -18,9 +18,10 @@
 #include <optional>
 #include <string>
 
+#include "fusedet/drivers/canopen/tilt_drive.h"
+#include "fusedet/drivers/canopen/tilt_tpdo.h"
 #include "fusedet/drivers/log/channels.h"
 #include "fusedet/drivers/log/mcap_reader.h"
-#include "fusedet/drivers/log/tilt_decoder.h"
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/lms291/scan_decoder.h"
 #include "fusedet/drivers/lms291/telegram.h"
@@ -81,7 +82,7 @@ class LogSource {
 
 struct SensorReplayConfig {
   lms291::Lms291Config laser;  // variant, remission, measuring mode: what the driver set the device to
-  TiltDecoderConfig tilt;      // node id and position units of the tilt motor
+  canopen::TiltDriveConfig tilt;  // the live drive's config: node id and position units (TPDO1 decoding)
 };
 
 struct SensorReplayCounters {
@@ -89,6 +90,7 @@ struct SensorReplayCounters {
   lms291::ReaderCounters telegrams;  // bytes, telegrams, CRC errors, resyncs, expired frames
   std::uint64_t scans = 0, lostScans = 0, badScans = 0;
   std::uint64_t tiltSamples = 0;
+  std::uint64_t badTpdos = 0;  // TPDO1 frames too short to decode
   std::uint64_t frames = 0;
 };
 
@@ -119,7 +121,7 @@ class SensorReplay {
   SensorReplayConfig config_;
   lms291::TelegramReader telegrams_{lms291::Direction::kFromDevice};
   lms291::ScanDecoder scans_;
-  TiltDecoder tilt_;
+  canopen::TiltTpdoDecoder tilt_;
   int baud_ = 0;
   Stamp lastSerial_{};
   std::uint64_t frames_ = 0;
