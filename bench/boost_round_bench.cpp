@@ -144,6 +144,7 @@ struct Args {
   int threads = 2, rounds = 5;
   int mlReps = 2;  // repetitions of ml::Boost's 0-, 1- and 2-tree trainings
   bool skipMlBoost = false;
+  bool skipXgboost = false;
   bool oursOnly = false;  // tuning: no peers, no headline ratios
   std::string source = "kitti";
   std::size_t maxFrames = 0;
@@ -176,6 +177,7 @@ Args parse(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("--skip-mlboost", a.skipMlBoost, "leave ml::Boost out");
+  app.add_flag("--skip-xgboost", a.skipXgboost, "leave XGBoost out (its matrix peaks at ~17 GB RSS at full size)");
   app.add_flag("--ours-only", a.oursOnly, "tuning: ours only, no peers, no headline ratios");
   try {
     app.parse(argc, argv);
@@ -257,30 +259,34 @@ int main(int argc, char** argv) try {
   // ---- XGBoost: setup ----
   // QuantileDMatrix fed by an iterator over row batches (XGBoost's path for hist that keeps no CSR
   // copy of the values). Its sketches still take ~70 KB per feature while it is built.
-  const double rssX = rssMb();
+  // --skip-xgboost leaves it out (b stays null): its matrix peaks at ~17 GB RSS at full size.
   XgBatches it{&d, &y, &w, nullptr, 0, a.xgBatch};
-  xgCheck(XGProxyDMatrixCreate(&it.proxy), "XGProxyDMatrixCreate");
   DMatrixHandle dm = nullptr;
-  const std::string cfg =
-      R"({"missing": NaN, "nthread": )" + std::to_string(a.xgBuildThreads) + R"(, "max_bin": 256})";
-  t0 = Clock::now();
-  xgCheck(XGQuantileDMatrixCreateFromCallback(&it, it.proxy, nullptr, &XgBatches::reset, &XgBatches::next,
-                                              cfg.c_str(), &dm),
-          "XGQuantileDMatrixCreateFromCallback");
-  const double xgSetup = since(t0);
-  const double xgPeak = procStatusMb("VmHWM:");
   BoosterHandle b = nullptr;
-  xgCheck(XGBoosterCreate(&dm, 1, &b), "XGBoosterCreate");
-  const std::string nthread = std::to_string(a.threads);
-  const char* params[][2] = {{"tree_method", "hist"}, {"max_depth", "1"},    {"eta", "1"},
-                             {"lambda", "0"},         {"alpha", "0"},        {"gamma", "0"},
-                             {"min_child_weight", "0"}, {"max_bin", "256"},  {"base_score", "0"},
-                             {"objective", "reg:squarederror"}, {"nthread", nthread.c_str()},
-                             {"verbosity", "0"}};
-  for (auto& p : params) xgCheck(XGBoosterSetParam(b, p[0], p[1]), p[0]);
-  std::printf("xgboost: QuantileDMatrix (sketch + bin index) %.2f s with %d threads (our binning: %d), RSS +%.0f MB "
-              "(peak RSS so far %.0f MB)\n",
-              xgSetup, a.xgBuildThreads, a.threads, rssMb() - rssX, xgPeak);
+  double xgSetup = 0;
+  if (!a.skipXgboost) {
+    const double rssX = rssMb();
+    xgCheck(XGProxyDMatrixCreate(&it.proxy), "XGProxyDMatrixCreate");
+    const std::string cfg =
+        R"({"missing": NaN, "nthread": )" + std::to_string(a.xgBuildThreads) + R"(, "max_bin": 256})";
+    t0 = Clock::now();
+    xgCheck(XGQuantileDMatrixCreateFromCallback(&it, it.proxy, nullptr, &XgBatches::reset, &XgBatches::next,
+                                                cfg.c_str(), &dm),
+            "XGQuantileDMatrixCreateFromCallback");
+    xgSetup = since(t0);
+    const double xgPeak = procStatusMb("VmHWM:");
+    xgCheck(XGBoosterCreate(&dm, 1, &b), "XGBoosterCreate");
+    const std::string nthread = std::to_string(a.threads);
+    const char* params[][2] = {{"tree_method", "hist"}, {"max_depth", "1"},    {"eta", "1"},
+                               {"lambda", "0"},         {"alpha", "0"},        {"gamma", "0"},
+                               {"min_child_weight", "0"}, {"max_bin", "256"},  {"base_score", "0"},
+                               {"objective", "reg:squarederror"}, {"nthread", nthread.c_str()},
+                               {"verbosity", "0"}};
+    for (auto& p : params) xgCheck(XGBoosterSetParam(b, p[0], p[1]), p[0]);
+    std::printf("xgboost: QuantileDMatrix (sketch + bin index) %.2f s with %d threads (our binning: %d), RSS +%.0f MB "
+                "(peak RSS so far %.0f MB)\n",
+                xgSetup, a.xgBuildThreads, a.threads, rssMb() - rssX, xgPeak);
+  }
 
   // ---- rounds, interleaved: the machine's load hits both alike ----
   std::vector<double> ourTimes, ourCpu, xgTimes;
@@ -291,17 +297,18 @@ int main(int argc, char** argv) try {
     ours = fusedet::boosting::findBestStump(m, P, w, raw, opt);
     ourCpu.push_back(processCpu() - c0);
     ourTimes.push_back(since(t0));
+    if (!b) continue;
     t0 = Clock::now();
     xgCheck(XGBoosterUpdateOneIter(b, r, dm), "XGBoosterUpdateOneIter");
     xgTimes.push_back(since(t0));
   }
-  const double xgFirstRound = xgTimes.front();
+  const double xgFirstRound = b ? xgTimes.front() : 0;
   std::sort(ourTimes.begin(), ourTimes.end());
   std::sort(xgTimes.begin(), xgTimes.end());
   const double oursSeconds = ourTimes[ourTimes.size() / 2];
   std::sort(ourCpu.begin(), ourCpu.end());
   const double oursCpuSeconds = ourCpu[ourCpu.size() / 2];  // CPU of all our threads in one round
-  const double xgRound = xgTimes[xgTimes.size() / 2];
+  const double xgRound = b ? xgTimes[xgTimes.size() / 2] : 0;
   std::vector<float> pred(N);
   for (std::size_t i = 0; i < N; ++i) pred[i] = float(ours(d.values[i * F + ours.feature]));
   const double oursError = weightedError(pred, y, w);
@@ -311,7 +318,7 @@ int main(int argc, char** argv) try {
               ours.right, oursError);
   // XGBoost's first tree alone (the same weights as ours), from its own predictions.
   double xgError = 0;
-  {
+  if (b) {
     const char* pcfg = R"({"type": 0, "training": false, "iteration_begin": 0, "iteration_end": 1, "strict_shape": false, "missing": NaN, "cache_id": 0})";
     bst_ulong const* shape = nullptr;
     bst_ulong dim = 0;
@@ -320,12 +327,12 @@ int main(int argc, char** argv) try {
     xgCheck(XGBoosterPredictFromDense(b, all.c_str(), pcfg, nullptr, &shape, &dim, &out), "predict");
     std::vector<float> xp(out, out + N);
     xgError = weightedError(xp, y, w);
+    std::printf("xgboost: round %.4f s (median of %d, min %.4f, first %.4f), error of the first tree %.6f\n",
+                xgRound, a.rounds, xgTimes.front(), xgFirstRound, xgError);
+    XGBoosterFree(b);
+    XGDMatrixFree(dm);
+    XGDMatrixFree(it.proxy);
   }
-  std::printf("xgboost: round %.4f s (median of %d, min %.4f, first %.4f), error of the first tree %.6f\n",
-              xgRound, a.rounds, xgTimes.front(), xgFirstRound, xgError);
-  XGBoosterFree(b);
-  XGDMatrixFree(dm);
-  XGDMatrixFree(it.proxy);
 
   // ---- cv::ml::Boost ----
   // Single-threaded by construction. Every time printed is measured, none found by subtraction:
@@ -401,8 +408,10 @@ int main(int argc, char** argv) try {
 
   std::printf("bench: round_seconds %.4f\n", oursSeconds);
   std::printf("bench: binning_seconds_per_stage %.3f\n", binSeconds);
-  std::printf("bench: speedup_vs_xgboost %.2f\n", xgRound / oursSeconds);
-  std::printf("bench: speedup_vs_xgboost_incl_setup %.2f\n", (xgSetup + xgRound) / (binSeconds + oursSeconds));
+  if (b) {
+    std::printf("bench: speedup_vs_xgboost %.2f\n", xgRound / oursSeconds);
+    std::printf("bench: speedup_vs_xgboost_incl_setup %.2f\n", (xgSetup + xgRound) / (binSeconds + oursSeconds));
+  }
   if (!a.skipMlBoost) {
     std::printf("equal terms: rounds against rounds, set-ups timed apart (none by subtraction); ours and XGBoost on "
                 "%d threads, ml::Boost on 1 by construction: wall-clock ratio = its round's wall time / ours; "
@@ -415,7 +424,7 @@ int main(int argc, char** argv) try {
     std::printf("bench: speedup_vs_mlboost_incl_setup %.2f\n",
                 (ml.setup().wall + ml.round().wall) / (binSeconds + oursSeconds));
   }
-  std::printf("bench: stump_error_ratio_vs_xgboost %.5f\n", oursError / xgError);
+  if (b) std::printf("bench: stump_error_ratio_vs_xgboost %.5f\n", oursError / xgError);
   if (!a.skipMlBoost) std::printf("bench: stump_error_ratio_vs_mlboost %.5f\n", oursError / mlError);
   return 0;
 } catch (const std::exception& e) {
