@@ -19,8 +19,9 @@ int main(int argc, char** argv) {
                "load and validate the configuration, print the effective values, exit 0 if valid");
   app.set_version_flag("--version", std::string("fusedetd ") + FUSEDET_VERSION);
   app.footer(
-      "Runs sources (live: the LMS 291 on laser.device), fusion and every configured class cascade,\n"
-      "and serves detections as newline-delimited JSON on a Unix stream socket (docs/protocol.md;\n"
+      "Runs sources (live: the LMS 291 on laser.device, the tilt motor on tilt.interface, the camera\n"
+      "on camera.device; replay: the sensor log in replay.file), fusion and every configured class\n"
+      "cascade, and serves detections as newline-delimited JSON on a Unix stream socket (docs/protocol.md;\n"
       "`fusedet query` is a client). Under systemd (Type=notify) it reports READY=1 once serving,\n"
       "STATUS= lines, and WATCHDOG=1 while its pipeline threads are alive; it takes the socket from\n"
       "socket activation when given one, else binds --socket or socket.path.\n\n"
@@ -28,10 +29,17 @@ int main(int argc, char** argv) {
       "  SIGHUP   reload the config file and the models; a bad file keeps the running configuration\n"
       "           (the log and `status` say why); clients stay connected\n"
       "  SIGTERM  stop the sources, drain queued work, flush clients, exit 0 within 2 s\n\n"
-      "Exit status: 0 after SIGTERM/SIGINT or a valid --check-config, 1 on a start-up error.\n\n"
+      "Replay (replay.file set): the log's own rig (laser, tilt, camera, fusion sections and camera\n"
+      "calibration from its metadata) with this file's detection, models and socket; paced like the\n"
+      "recording (replay.realtime, replay.speed) or as fast as the pipeline takes it (nothing\n"
+      "dropped, deterministic). At the end of the log (replay.at_end): exit = drain, flush clients,\n"
+      "exit 0; idle = keep serving; loop = start again. `status` shows the replay's progress.\n\n"
+      "Exit status: 0 after SIGTERM/SIGINT, the end of a replay with at_end exit, or a valid\n"
+      "--check-config; 1 on a start-up error (bad config, missing model, log that is not MCAP).\n\n"
       "Examples:\n"
       "  fusedetd --config /etc/fusedet/fusedet.yaml --check-config\n"
-      "  fusedetd --config config/fusedet.yaml --socket /tmp/fusedet.sock");
+      "  fusedetd --config config/fusedet.yaml --socket /tmp/fusedet.sock\n"
+      "  fusedet synth-log --out build/logs/demo.mcap && fusedetd --config config/demo.yaml --socket /tmp/demo.sock");
   CLI11_PARSE(app, argc, argv);
   if (checkOnly) {
     try {

@@ -192,6 +192,11 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     Section s = top.child("replay");
     s.read("file", c.replay.file);
     s.read("realtime", c.replay.realtime);
+    s.readRange("speed", c.replay.speed, 0.01, 100.0);
+    s.read("restamp", c.replay.restamp);
+    s.readOneOf<std::string>("at_end", c.replay.atEnd, {"exit", "idle", "loop"});
+    if (c.replay.atEnd == "loop" && !c.replay.restamp)
+      s.fail(s.at("at_end"), "key replay.at_end: loop needs replay.restamp true (stamps must keep increasing)");
     s.finish();
   }
   top.finish();
@@ -282,7 +287,10 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "threads" << YAML::Value << c.detection.threads << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << c.replay.file;
-  out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime << YAML::EndMap;
+  out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime;
+  out << YAML::Key << "speed" << YAML::Value << c.replay.speed;
+  out << YAML::Key << "restamp" << YAML::Value << c.replay.restamp;
+  out << YAML::Key << "at_end" << YAML::Value << c.replay.atEnd << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -74,6 +74,20 @@ void Pipeline::onScene(PairedScene scene) {
   sensorQueue_.push(std::move(scene));
 }
 
+void Pipeline::onEndOfStream() { sensorQueue_.push(EndOfStream{}); }
+
+void Pipeline::awaitRoom(const std::atomic<bool>& stop) {
+  const std::size_t maxDepth = sensorQueue_.capacity() / 2;
+  while (!stop && !sensorQueue_.waitForRoom(maxDepth, kIdleWake))
+    if (sensorQueue_.closed()) return;
+}
+
+bool Pipeline::idle() const {
+  const PipelineCounters c = counters();
+  return c.sensorQueue.depth == 0 && c.handled == c.sensorQueue.pushed - c.sensorQueue.dropped &&
+         c.stackQueue.depth == 0 && c.stacksFused == c.stacksDetected + c.detectErrors + c.stackQueue.dropped;
+}
+
 void Pipeline::fusionLoop() {
   while (!abandon_) {
     fusionBeat_ = Stamp::now().ns;
@@ -89,6 +103,8 @@ void Pipeline::fusionLoop() {
       ++counters_.fuseErrors;
       spdlog::warn("fusion: {}", e.what());
     }
+    std::lock_guard lock(countersMutex_);
+    ++counters_.handled;
   }
   stackQueue_.close();
 }
@@ -106,6 +122,10 @@ void Pipeline::handle(SensorMessage& message) {
       ++counters_.scenes;
     }
     fuseAndQueue(scene->sweep, scene->frame);
+  } else if (std::holds_alternative<EndOfStream>(message)) {
+    assembler_.flush();  // the last sweep has no reversal to close it
+    std::lock_guard lock(countersMutex_);
+    ++counters_.streamEnds;
   }
   for (const fusion::Sweep& sweep : assembler_.takeSweeps())
     if (auto frame = pairer_.pair(sweep)) fuseAndQueue(sweep, *frame);
@@ -137,6 +157,11 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
     ++counters_.stacksFused;
     counters_.lastFuseMs = fused.fuseMs;
   }
+  if (setup_.lossless)
+    while (!stackQueue_.waitForRoom(stackQueue_.capacity() - 1, kIdleWake)) {
+      if (abandon_ || stackQueue_.closed()) return;
+      fusionBeat_ = Stamp::now().ns;  // waiting for detection is not a stall of this thread
+    }
   stackQueue_.push(std::move(fused));
 }
 
@@ -176,13 +201,14 @@ void Pipeline::detectionLoop() {
     result->detectMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     result->detectedAt = Stamp::now();
     stackRate_.tick(result->detectedAt.ns);
-    {
-      std::lock_guard lock(countersMutex_);
-      ++counters_.stacksDetected;
-      counters_.detections += result->detections.size();
-      counters_.lastDetectMs = result->detectMs;
-    }
+    const std::size_t found = result->detections.size();
+    const double detectMs = result->detectMs;
     onResult_(std::move(result));
+    // Counted after the hand-over: a stack counted as detected has reached the server.
+    std::lock_guard lock(countersMutex_);
+    ++counters_.stacksDetected;
+    counters_.detections += found;
+    counters_.lastDetectMs = detectMs;
   }
   detectionDone_ = true;
 }

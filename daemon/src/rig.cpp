@@ -51,4 +51,31 @@ drivers::v4l2::FrameStreamTiming cameraTiming(const Config& c) {
   return t;
 }
 
+ReplayRig replayRig(const std::filesystem::path& log, const Config& machine, const std::filesystem::path& configDir) {
+  const drivers::logs::LogSource probe(log);
+  const std::optional<drivers::logs::LogRig> rig = probe.rig();
+  ReplayRig out;
+  out.config = machine;
+  if (rig) {
+    const Config recorded = parseConfig(rig->configYaml, log.string() + ":fusedet.config");
+    out.config.laser = recorded.laser;
+    out.config.tilt = recorded.tilt;
+    out.config.camera = recorded.camera;
+    out.config.fusion = recorded.fusion;
+    out.origin = log.string() + " (metadata fusedet.config)";
+  } else {
+    out.origin = "the machine config (the log carries no fusedet.config)";
+  }
+  const std::string& calibration = out.config.camera.calibration;
+  if (rig && calibration == "log:camera.yaml") {
+    if (rig->cameraYaml.empty()) throw std::runtime_error(log.string() + ": fusedet.config has no camera.yaml");
+    out.camera = fusion::parseCameraModel(rig->cameraYaml, log.string() + ":camera.yaml");
+  } else {
+    std::filesystem::path file = calibration;
+    if (file.is_relative()) file = configDir / file;
+    out.camera = fusion::readCameraModel(file);
+  }
+  return out;
+}
+
 }  // namespace fusedet::daemon

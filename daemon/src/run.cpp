@@ -10,10 +10,8 @@
 
 #include <chrono>
 
-#include "fusedet/daemon/camera_source.h"
-#include "fusedet/daemon/lms291_source.h"
+#include "fusedet/daemon/service_parts.h"
 #include "fusedet/daemon/server.h"
-#include "fusedet/daemon/tilt_source.h"
 #include "fusedet/daemon/service.h"
 
 namespace fusedet::daemon {
@@ -40,21 +38,6 @@ drivers::UniqueFd listenerFor(const std::string& path) {
   return fd;
 }
 
-ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
-  if (!config.replay.file.empty())
-    throw std::runtime_error("replay.file is set, but this build has no sensor-log replay source");
-  ServiceParts parts;
-  parts.fuser = fuserFrom(config, configFile);
-  parts.detector = detectorFrom(config, configFile);
-  parts.sources.push_back(std::make_unique<Lms291Source>(config));
-  parts.sources.push_back(std::make_unique<TiltSource>(config.tilt));
-  parts.sources.push_back(std::make_unique<CameraSource>(config.camera));
-  parts.configFile = configFile;
-  parts.config = std::move(config);
-  parts.mode = "live";
-  return parts;
-}
-
 }  // namespace
 
 int runDaemon(const RunOptions& options) {
@@ -72,12 +55,14 @@ int runDaemon(const RunOptions& options) {
   spdlog::set_pattern("%^%l%$: %v");
 
   std::unique_ptr<Service> service;
+  bool exitAtEnd = false;  // replay.at_end: exit
   try {
     Config config = loadConfig(options.configFile);
     if (!options.socketPath.empty()) config.socket.path = options.socketPath;
     spdlog::set_level(spdlog::level::from_str(config.logLevel));
     const std::string socketPath = config.socket.path;
-    ServiceParts parts = liveParts(std::move(config), options.configFile);
+    exitAtEnd = !config.replay.file.empty() && config.replay.atEnd == "exit";
+    ServiceParts parts = serviceParts(std::move(config), options.configFile);
     parts.listener = listenerFor(socketPath);  // last: nothing is bound when the set-up fails
     service = std::make_unique<Service>(std::move(parts));
     service->start();
@@ -118,6 +103,12 @@ int runDaemon(const RunOptions& options) {
       }
     }
     if (watchdogUs && service->alive(maxAgeNs)) notify("WATCHDOG=1");
+    if (exitAtEnd && service->finished()) {
+      spdlog::info("end of the replayed log: flushing clients and stopping");
+      notify("STOPPING=1\nSTATUS=replay finished");
+      service->stop(Clock::now() + kShutdownBudget);
+      return 0;
+    }
     if (std::string now = service->summary(); now != shown) {
       shown = std::move(now);
       notify("STATUS=" + shown);

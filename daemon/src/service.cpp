@@ -13,7 +13,10 @@ namespace fusedet::daemon {
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile) {
   std::filesystem::path calibration = config.camera.calibration;
   if (calibration.is_relative()) calibration = configFile.parent_path() / calibration;
-  const fusion::CameraModel camera = fusion::readCameraModel(calibration);
+  return fuserFrom(config, fusion::readCameraModel(calibration));
+}
+
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera) {
   fusion::ProjectionConfig projection;
   projection.laserLayerScale = config.fusion.laserLayerScale;
   projection.holeFillRadius = config.fusion.holeFillRadius;
@@ -40,10 +43,12 @@ Service::Service(ServiceParts parts)
       sources_(std::move(parts.sources)) {
   Server::Handlers handlers{[this] { return hello(); }, [this] { return status(); }};
   server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
+  const Config& sensors = parts.sensorConfig ? *parts.sensorConfig : config_;
   PipelineSetup setup;
   setup.fuser = std::move(parts.fuser);
-  setup.sweep = sweepConfig(config_);
-  setup.maxPairSkewNs = std::int64_t{config_.fusion.maxPairSkewMs} * 1'000'000;
+  setup.sweep = sweepConfig(sensors);
+  setup.maxPairSkewNs = std::int64_t{sensors.fusion.maxPairSkewMs} * 1'000'000;
+  setup.lossless = parts.lossless;
   pipeline_ = std::make_unique<Pipeline>(std::move(setup), std::move(parts.detector),
                                          [this](std::shared_ptr<const StackResult> r) { server_->publish(std::move(r)); });
 }
@@ -126,14 +131,20 @@ nlohmann::json Service::status() const {
   const LatencySummary lat = server_->latency();
   nlohmann::json sensors = nlohmann::json::array();
   for (const auto& src : sources_)
-    for (const SensorHealth& h : src->health())
-      sensors.push_back({{"name", h.name},
-                         {"state", h.state},
-                         {"messages", h.messages},
-                         {"crc_errors", h.crcErrors},
-                         {"reconnects", h.reconnects},
-                         {"lost", h.lost},
-                         {"last_error", h.lastError}});
+    for (const SensorHealth& h : src->health()) {
+      nlohmann::json entry{{"name", h.name},
+                           {"state", h.state},
+                           {"messages", h.messages},
+                           {"crc_errors", h.crcErrors},
+                           {"reconnects", h.reconnects},
+                           {"lost", h.lost},
+                           {"last_error", h.lastError}};
+      if (h.progress) {
+        entry["progress"] = *h.progress;
+        entry["passes"] = h.passes;
+      }
+      sensors.push_back(std::move(entry));
+    }
   std::lock_guard lock(mutex_);
   return {
       {"mode", mode_},
@@ -168,6 +179,13 @@ nlohmann::json Service::status() const {
       {"last_reload_error", lastReloadError_}};
 }
 
+bool Service::finished() const {
+  if (sources_.empty()) return false;
+  for (const auto& s : sources_)
+    if (!s->finished()) return false;
+  return pipeline_->idle();
+}
+
 bool Service::alive(std::int64_t maxAgeNs) const {
   const std::int64_t now = Stamp::now().ns;
   return now - pipeline_->fusionBeatNs() < maxAgeNs && now - pipeline_->detectionBeatNs() < maxAgeNs &&
@@ -183,6 +201,7 @@ std::string Service::summary() const {
   for (const auto& src : sources_)
     for (const SensorHealth& h : src->health()) {
       o << (first ? "" : ", ") << h.name << ' ' << h.state;
+      if (h.progress) o << ' ' << static_cast<int>(*h.progress * 100) << '%';
       first = false;
     }
   o << "; " << p.stacksDetected << " stacks, " << p.stackQueue.dropped << " dropped; " << s.clients << " clients";

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 using namespace fusedet::daemon;
 
 namespace {
@@ -63,6 +65,32 @@ TEST(Config, CameraKeys) {
   EXPECT_NE(errorOf("camera:\n  usb: '0403'\n").find("test.yaml:2: key camera.usb: USB device '0403': no ':'"),
             std::string::npos);
   EXPECT_NE(errorOf("camera:\n  format: rgb\n").find("is not one of: yuyv mjpeg auto"), std::string::npos);
+}
+
+TEST(Config, ReplayKeys) {
+  const Config c = parseConfig("replay:\n  file: run.mcap\n  realtime: false\n  speed: 2.5\n  at_end: exit\n", "r.yaml");
+  EXPECT_EQ(c.replay.file, "run.mcap");
+  EXPECT_FALSE(c.replay.realtime);
+  EXPECT_EQ(c.replay.speed, 2.5);
+  EXPECT_TRUE(c.replay.restamp);
+  EXPECT_EQ(c.replay.atEnd, "exit");
+  const Config back = parseConfig(dumpConfig(c), "dump.yaml");
+  EXPECT_EQ(back.replay.speed, 2.5);
+  EXPECT_EQ(back.replay.atEnd, "exit");
+  EXPECT_NE(errorOf("replay:\n  at_end: stop\n").find("test.yaml:2: key replay.at_end: 'stop' is not one of: exit idle loop"),
+            std::string::npos);
+  EXPECT_EQ(errorOf("replay:\n  restamp: false\n  at_end: loop\n"),
+            "test.yaml:3: key replay.at_end: loop needs replay.restamp true (stamps must keep increasing)");
+  EXPECT_EQ(errorOf("replay:\n  speed: 0\n"), "test.yaml:2: key replay.speed: 0 is outside [0.01, 100]");
+}
+
+TEST(Config, DemoFileLoadsAndNamesTheBundledModels) {
+  const std::filesystem::path dir = std::filesystem::path(FUSEDET_SOURCE_DIR) / "config";
+  const Config demo = loadConfig(dir / "demo.yaml");
+  EXPECT_EQ(demo.replay.file, "../build/logs/demo.mcap");
+  EXPECT_EQ(demo.replay.atEnd, "exit");
+  ASSERT_EQ(demo.detection.models.size(), 3u);
+  for (const auto& m : demo.detection.models) EXPECT_TRUE(std::filesystem::exists(dir / m)) << m;
 }
 
 TEST(Config, MissingFile) {

@@ -1,7 +1,8 @@
-// fusedetd as a process, the way systemd runs it: READY=1 / STATUS= / WATCHDOG=1 / STOPPING=1 on
-// a test NOTIFY_SOCKET, SIGHUP reload with a bad and then a good file while a client stays
-// connected, SIGTERM exit within 2 s, socket activation through systemd-socket-activate, and
-// clear start-up errors. No hardware: the laser port does not exist and keeps reconnecting.
+// fusedetd as a process, the way systemd runs it, replaying a synthesised sensor log (the live
+// devices of the config do not exist): READY=1 / STATUS= / WATCHDOG=1 / STOPPING=1 on a test
+// NOTIFY_SOCKET, SIGHUP reload with a bad and then a good file while a subscribed client keeps
+// receiving, SIGTERM exit within 2 s, socket activation through systemd-socket-activate (replay
+// and live with absent devices), the end of a log with `at_end: exit`, and clear start-up errors.
 
 #include <gtest/gtest.h>
 #include <fcntl.h>
@@ -13,12 +14,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstring>
+#include <mutex>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
 #include "fusedet/daemon/client.h"
+#include "replay_logs.h"
 
 extern char** environ;
 
@@ -47,6 +52,14 @@ void writeConfig(const fs::path& file, const std::string& socket, const std::vec
       << "/tests/daemon/data/camera.yaml\ndetection:\n  models: [";
   for (std::size_t i = 0; i < classes.size(); ++i) out << (i ? ", " : "") << model(classes[i]);
   out << "]\n" << extra;
+}
+
+// The config above replaying the 3-stroke test log (its own rig replaces the device sections).
+void writeReplayConfig(const fs::path& file, const std::string& socket, const std::vector<std::string>& classes,
+                       const std::string& atEnd = "loop", bool realtime = true) {
+  writeConfig(file, socket, classes,
+              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(3).string() + "\n  at_end: " + atEnd +
+                  "\n  realtime: " + (realtime ? "true" : "false") + "\n");
 }
 
 class Process {
@@ -90,7 +103,8 @@ class Process {
   bool exited_ = false;
 };
 
-// A datagram socket standing in for systemd's notification socket.
+// A datagram socket standing in for systemd's notification socket. Like systemd it reads all the
+// time (a thread): a full socket queue would block the daemon's sd_notify.
 class NotifySocket {
  public:
   explicit NotifySocket(const fs::path& path) : path_(path) {
@@ -99,32 +113,61 @@ class NotifySocket {
     a.sun_family = AF_UNIX;
     std::strncpy(a.sun_path, path.c_str(), sizeof a.sun_path - 1);
     if (::bind(fd_.get(), reinterpret_cast<sockaddr*>(&a), sizeof a) < 0) throw std::runtime_error("bind notify");
+    reader_ = std::thread([this] {
+      while (!stop_) {
+        pollfd p{fd_.get(), POLLIN, 0};
+        if (::poll(&p, 1, 50) <= 0) continue;
+        char buf[4096];
+        const ssize_t n = ::recv(fd_.get(), buf, sizeof buf, 0);
+        if (n <= 0) continue;
+        std::lock_guard lock(mutex_);
+        messages_.emplace_back(buf, static_cast<std::size_t>(n));
+      }
+    });
+  }
+  ~NotifySocket() {
+    stop_ = true;
+    reader_.join();
   }
   std::string env() const { return "NOTIFY_SOCKET=" + path_.string(); }
-  // Waits for a message containing `needle`; every message seen is kept in `seen`.
+  // Waits for a message after the previous match (or clear()) containing `needle`.
   bool waitFor(const std::string& needle, std::chrono::milliseconds timeout) {
     const auto end = std::chrono::steady_clock::now() + timeout;
-    while (std::chrono::steady_clock::now() < end) {
-      pollfd p{fd_.get(), POLLIN, 0};
-      if (::poll(&p, 1, 50) <= 0) continue;
-      char buf[4096];
-      const ssize_t n = ::recv(fd_.get(), buf, sizeof buf, 0);
-      if (n <= 0) continue;
-      seen.emplace_back(buf, static_cast<std::size_t>(n));
-      if (seen.back().find(needle) != std::string::npos) return true;
+    for (;;) {
+      {
+        std::lock_guard lock(mutex_);
+        for (; cursor_ < messages_.size(); ++cursor_)
+          if (messages_[cursor_].find(needle) != std::string::npos) {
+            match_ = messages_[cursor_++];
+            return true;
+          }
+      }
+      if (std::chrono::steady_clock::now() > end) return false;
+      std::this_thread::sleep_for(10ms);
     }
-    return false;
+  }
+  const std::string& lastMatch() const { return match_; }
+  // Forgets the messages so far for count() and waitFor().
+  void clear() {
+    std::lock_guard lock(mutex_);
+    mark_ = cursor_ = messages_.size();
   }
   int count(const std::string& needle) const {
+    std::lock_guard lock(mutex_);
     int n = 0;
-    for (const auto& s : seen) n += s.find(needle) != std::string::npos;
+    for (std::size_t i = mark_; i < messages_.size(); ++i) n += messages_[i].find(needle) != std::string::npos;
     return n;
   }
-  std::vector<std::string> seen;
 
  private:
   fs::path path_;
   fusedet::drivers::UniqueFd fd_;
+  mutable std::mutex mutex_;
+  std::vector<std::string> messages_;
+  std::size_t mark_ = 0, cursor_ = 0;
+  std::string match_;
+  std::atomic<bool> stop_{false};
+  std::thread reader_;
 };
 
 std::string readFile(const fs::path& p) {
@@ -145,30 +188,43 @@ nlohmann::json ask(Client& c, const std::string& cmd) {
 TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
   const fs::path dir = tempDir("notify");
   const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
-  writeConfig(config, socket, {"car", "bike", "person"});
+  writeReplayConfig(config, socket, {"car", "bike", "person"});
   NotifySocket notify(dir / "notify");
   Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=400000"}, dir / "log");
   ASSERT_GT(daemon.pid(), 0);
   ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
-  EXPECT_NE(notify.seen.back().find("STATUS=live: laser"), std::string::npos) << notify.seen.back();
+  EXPECT_NE(notify.lastMatch().find("STATUS=replay: replay replaying"), std::string::npos) << notify.lastMatch();
   // READY=1 means served: a client gets its hello at once.
   Client client(socket.string());
-  EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
+  const auto hello = ask(client, "hello");
+  EXPECT_EQ(hello["classes"], nlohmann::json({"car", "bike", "person"}));
+  EXPECT_EQ(hello["mode"], "replay");
+  // A subscriber receives the replayed stacks (reload below must not cut it off).
+  Client subscriber(socket.string());
+  subscriber.send({{"cmd", "subscribe"}});
+  auto nextDetections = [&subscriber](std::chrono::milliseconds timeout) -> nlohmann::json {
+    const auto end = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < end)
+      if (auto m = subscriber.read(1s); m && (*m)["type"] == "detections") return *m;
+    return {};
+  };
+  ASSERT_FALSE(nextDetections(60s).is_null()) << readFile(dir / "log");
   // Watchdog pings at a quarter..half of WATCHDOG_USEC while the pipeline threads are alive.
-  notify.seen.clear();
-  notify.waitFor("never sent", 1500ms);
+  notify.clear();
+  std::this_thread::sleep_for(1500ms);
   EXPECT_GE(notify.count("WATCHDOG=1"), 3);
 
   // A broken file: the running configuration stays, STATUS= and `status` say why.
   { std::ofstream(config) << "detection:\n  modles: []\n"; }
+  notify.clear();
   ::kill(daemon.pid(), SIGHUP);
   ASSERT_TRUE(notify.waitFor("reload failed", 10s)) << readFile(dir / "log");
-  const auto status = ask(client, "status");
-  EXPECT_NE(status["last_reload_error"].get<std::string>().find("unknown key detection.modles"), std::string::npos)
-      << status.dump();
+  const auto failed = ask(client, "status");
+  EXPECT_NE(failed["last_reload_error"].get<std::string>().find("unknown key detection.modles"), std::string::npos)
+      << failed.dump();
   EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
-  // A good one applies, the same connection stays.
-  writeConfig(config, socket, {"bike"});
+  // A good one applies, the same connections stay and the subscriber keeps receiving.
+  writeReplayConfig(config, socket, {"bike"});
   ::kill(daemon.pid(), SIGHUP);
   bool applied = false;
   for (int i = 0; i < 100 && !applied; ++i) {
@@ -176,7 +232,21 @@ TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
     if (!applied) std::this_thread::sleep_for(100ms);
   }
   EXPECT_TRUE(applied);
-  EXPECT_EQ(ask(client, "status")["clients"]["disconnected"], 0);
+  // Stacks fused after the reload are detected with the new models only.
+  const auto fusedAtReload = ask(client, "status")["pipeline"]["stacks_fused"].get<std::uint64_t>();
+  int after = 0;
+  while (after < 2) {
+    const auto m = nextDetections(60s);
+    ASSERT_FALSE(m.is_null()) << "the subscriber stopped receiving after the reload";
+    if (m["stack"].get<std::uint64_t>() < fusedAtReload) continue;
+    ++after;
+    for (const auto& d : m["detections"]) EXPECT_EQ(d["class"], "bike");
+  }
+  const auto status = ask(client, "status");
+  EXPECT_EQ(status["clients"]["disconnected"], 0);
+  EXPECT_EQ(status["clients"]["dropped_slow"], 0);
+  EXPECT_EQ(status["sensors"][0]["name"], "replay");
+  EXPECT_GT(status["pipeline"]["stacks_detected"].get<int>(), 0);
 
   const auto t0 = std::chrono::steady_clock::now();
   ::kill(daemon.pid(), SIGTERM);
@@ -191,26 +261,61 @@ TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
 
 TEST(Fusedetd, SocketActivationUsesThePassedSocket) {
   if (::access("/usr/bin/systemd-socket-activate", X_OK) != 0) GTEST_SKIP() << "systemd-socket-activate missing";
-  const fs::path dir = tempDir("activate");
-  const fs::path config = dir / "fusedet.yaml", activated = dir / "activated.sock", configured = dir / "configured.sock";
-  writeConfig(config, configured, {"car"});
-  Process daemon({"/usr/bin/systemd-socket-activate", "-l", activated.string(), kDaemon, "--config", config.string()}, {},
-                 dir / "log");
-  // systemd-socket-activate binds at once; the daemon then takes the socket as fd 3.
+  for (const std::string mode : {"replay", "live"}) {
+    SCOPED_TRACE(mode);
+    const fs::path dir = tempDir("activate-" + mode);
+    const fs::path config = dir / "fusedet.yaml", activated = dir / "activated.sock", configured = dir / "configured.sock";
+    if (mode == "replay")
+      writeReplayConfig(config, configured, {"car"});
+    else
+      writeConfig(config, configured, {"car"});
+    Process daemon({"/usr/bin/systemd-socket-activate", "-l", activated.string(), kDaemon, "--config", config.string()},
+                   {}, dir / "log");
+    // systemd-socket-activate binds at once; the daemon then takes the socket as fd 3.
+    std::unique_ptr<Client> client;
+    for (int i = 0; i < 200 && !client; ++i) {
+      try {
+        client = std::make_unique<Client>(activated.string());
+      } catch (const std::exception&) {
+        std::this_thread::sleep_for(50ms);
+      }
+    }
+    ASSERT_TRUE(client);
+    const auto hello = ask(*client, "hello");
+    EXPECT_EQ(hello["classes"], nlohmann::json({"car"})) << readFile(dir / "log");
+    EXPECT_EQ(hello["mode"], mode);
+    EXPECT_FALSE(fs::exists(configured));  // the configured path was not bound
+    EXPECT_NE(readFile(dir / "log").find("socket systemd passed"), std::string::npos);
+    ::kill(daemon.pid(), SIGTERM);
+    EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+  }
+}
+
+// `replay.at_end: exit`: a client connected from the start gets every stroke's stack, then the
+// daemon drains, closes the connection and exits 0 by itself.
+TEST(Fusedetd, ReplayAtEndExitDeliversEveryStackThenExits0) {
+  const fs::path dir = tempDir("at-end");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
+  writeReplayConfig(config, socket, {"car", "bike", "person"}, "exit");
+  Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
   std::unique_ptr<Client> client;
-  for (int i = 0; i < 200 && !client; ++i) {
+  for (int i = 0; i < 1200 && !client; ++i) {  // the socket is bound before the replay starts
     try {
-      client = std::make_unique<Client>(activated.string());
+      client = std::make_unique<Client>(socket.string());
     } catch (const std::exception&) {
       std::this_thread::sleep_for(50ms);
     }
   }
-  ASSERT_TRUE(client);
-  EXPECT_EQ(ask(*client, "hello")["classes"], nlohmann::json({"car"})) << readFile(dir / "log");
-  EXPECT_FALSE(fs::exists(configured));  // the configured path was not bound
-  EXPECT_NE(readFile(dir / "log").find("socket systemd passed"), std::string::npos);
-  ::kill(daemon.pid(), SIGTERM);
-  EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+  ASSERT_TRUE(client) << readFile(dir / "log");
+  client->send({{"cmd", "subscribe"}});
+  std::vector<std::uint64_t> stacks;
+  while (auto m = client->read(60s))
+    if ((*m)["type"] == "detections") stacks.push_back((*m)["stack"]);
+  EXPECT_TRUE(client->closed());
+  EXPECT_EQ(daemon.wait(10s), 0) << readFile(dir / "log");
+  // Paced like the recording, the first stack comes 1.4 s after the start: nothing was missed.
+  EXPECT_EQ(stacks, (std::vector<std::uint64_t>{0, 1, 2})) << readFile(dir / "log");
+  EXPECT_NE(readFile(dir / "log").find("end of the replayed log"), std::string::npos);
 }
 
 TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
@@ -226,8 +331,12 @@ TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
   EXPECT_EQ(bad.wait(60s), 1);
   EXPECT_NE(readFile(dir / "log1").find("missing.yaml"), std::string::npos) << readFile(dir / "log1");
 
-  writeConfig(config, dir / "b.sock", {"car"}, "replay:\n  file: /tmp/some.mcap\n");
+  // A replay.file that is not a sensor log: exit 1 naming the file; nothing is bound.
+  std::ofstream(dir / "garbage.mcap") << "no MCAP here\n";
+  writeConfig(config, dir / "b.sock", {"car"}, "replay:\n  file: garbage.mcap\n");
   Process replay({kDaemon, "--config", config.string()}, {}, dir / "log2");
   EXPECT_EQ(replay.wait(60s), 1);
-  EXPECT_NE(readFile(dir / "log2").find("replay"), std::string::npos) << readFile(dir / "log2");
+  EXPECT_NE(readFile(dir / "log2").find("replay.file " + (dir / "garbage.mcap").string()), std::string::npos)
+      << readFile(dir / "log2");
+  EXPECT_FALSE(fs::exists(dir / "b.sock"));
 }

@@ -2,6 +2,8 @@
 // BoundedQueue: a small multi-producer, single-consumer queue between pipeline threads. push()
 // never blocks: when the queue is full the OLDEST item is dropped and counted, because for a robot
 // the newest sensor data is the valuable one and a driver thread must never wait on a consumer.
+// A producer that may wait (a log replayed as fast as possible, where nothing is lost by waiting)
+// uses waitForRoom() first.
 
 #include <chrono>
 #include <condition_variable>
@@ -43,12 +45,23 @@ class BoundedQueue {
 
   // Waits up to `timeout` for an item; nothing on timeout or when closed and empty.
   std::optional<T> pop(std::chrono::milliseconds timeout) {
-    std::unique_lock lock(mutex_);
-    ready_.wait_for(lock, timeout, [this] { return closed_ || !items_.empty(); });
-    if (items_.empty()) return std::nullopt;
-    T item = std::move(items_.front());
-    items_.pop_front();
+    std::optional<T> item;
+    {
+      std::unique_lock lock(mutex_);
+      ready_.wait_for(lock, timeout, [this] { return closed_ || !items_.empty(); });
+      if (items_.empty()) return std::nullopt;
+      item = std::move(items_.front());
+      items_.pop_front();
+    }
+    room_.notify_all();
     return item;
+  }
+
+  // Waits up to `timeout` until at most `maxDepth` items are queued (or the queue is closed).
+  // True when there is that much room.
+  bool waitForRoom(std::size_t maxDepth, std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    return room_.wait_for(lock, timeout, [&] { return closed_ || items_.size() <= maxDepth; }) && !closed_;
   }
 
   // Wakes the consumer; later pushes are refused, queued items can still be popped.
@@ -58,6 +71,7 @@ class BoundedQueue {
       closed_ = true;
     }
     ready_.notify_all();
+    room_.notify_all();
   }
 
   bool closed() const {
@@ -77,7 +91,7 @@ class BoundedQueue {
  private:
   const std::size_t capacity_;
   mutable std::mutex mutex_;
-  std::condition_variable ready_;
+  std::condition_variable ready_, room_;
   std::deque<T> items_;
   QueueCounters counters_;
   bool closed_ = false;

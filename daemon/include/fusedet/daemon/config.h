@@ -86,8 +86,11 @@ struct Config {
   } detection;
 
   struct Replay {
-    std::string file;
-    bool realtime = true;
+    std::string file;         // MCAP sensor log; non-empty = replay mode (relative: to the config's folder)
+    bool realtime = true;     // paced like the recording; false = as fast as possible, nothing dropped
+    double speed = 1.0;       // with realtime: 2 = twice the recorded speed
+    bool restamp = true;      // stamps shifted so the log starts "now"; false = recorded stamps
+    std::string atEnd = "idle";  // exit | idle | loop
   } replay;
 };
 

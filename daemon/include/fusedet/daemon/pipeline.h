@@ -3,7 +3,9 @@
 // (detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
 // own threads and push into the sensor queue through the SensorSink interface; both queues are
 // bounded and drop their oldest item when full (counted), so no producer ever waits. When
-// detection falls behind, the stack queue (2 deep) drops the oldest stack.
+// detection falls behind, the stack queue (2 deep) drops the oldest stack. Lossless mode (a log
+// replayed as fast as possible) is the exception: there the source waits for room (awaitRoom)
+// and fusion for detection, so every stack is detected and a replay is deterministic.
 
 #include <atomic>
 #include <functional>
@@ -49,12 +51,17 @@ struct PipelineSetup {
   std::int64_t maxPairSkewNs = 150'000'000;
   std::size_t sensorQueueCapacity = 512;  // messages between sources and fusion
   std::size_t stackQueueCapacity = 2;     // fused stacks waiting for detection
+  // Fusion waits for room in the stack queue instead of dropping the oldest stack. Only for
+  // sources that can wait too (a log replayed as fast as possible), never for live devices.
+  bool lossless = false;
 };
 
 struct PipelineCounters {
   QueueCounters sensorQueue, stackQueue;  // stackQueue.dropped = stacks detection never saw
   fusion::SweepStats sweeps;
   std::uint64_t scenes = 0;         // pre-paired scenes received
+  std::uint64_t handled = 0;        // sensor-queue messages the fusion thread finished with
+  std::uint64_t streamEnds = 0;     // end-of-stream marks handled (replay passes)
   std::uint64_t unpaired = 0;       // sweeps without a frame within the skew
   std::uint64_t decodeErrors = 0;   // camera frames that did not decode
   std::uint64_t fuseErrors = 0;
@@ -90,6 +97,13 @@ class Pipeline : public SensorSink {
   void onTilt(drivers::TiltSample sample) override;
   void onFrame(drivers::CameraFrame frame) override;
   void onScene(PairedScene scene) override;
+  void onEndOfStream() override;
+  // Waits for room for at least half the sensor queue (or `stop`, or the pipeline stopping).
+  void awaitRoom(const std::atomic<bool>& stop) override;
+
+  // Nothing queued or in work: every message taken is handled and every fused stack detected
+  // (or dropped), its result handed to the result callback.
+  bool idle() const;
 
   PipelineCounters counters() const;
   // Steady-clock ns of the last sign of life of the fusion and detection threads (each wakes at
@@ -98,7 +112,9 @@ class Pipeline : public SensorSink {
   std::int64_t detectionBeatNs() const { return detectionBeat_.load(); }
 
  private:
-  using SensorMessage = std::variant<drivers::LaserScan, drivers::TiltSample, drivers::CameraFrame, PairedScene>;
+  struct EndOfStream {};
+  using SensorMessage =
+      std::variant<drivers::LaserScan, drivers::TiltSample, drivers::CameraFrame, PairedScene, EndOfStream>;
   struct FusedStack {
     LayerStack stack;
     Stamp sweepStart, sweepEnd, frameStamp;

@@ -25,7 +25,7 @@ class SceneSource : public Source {
   std::vector<SensorHealth> health() const override;
   // Scenes emitted so far.
   std::uint64_t emitted() const { return emitted_.load(); }
-  bool finished() const { return finished_.load(); }
+  bool finished() const override { return finished_.load(); }
 
  private:
   void run(SensorSink& sink);

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,12 +29,18 @@ struct ServiceParts {
   std::vector<std::unique_ptr<Source>> sources;
   drivers::UniqueFd listener;  // bound and listening
   std::string mode = "live";   // "live" | "replay" | "scenes"
+  // The laser, tilt, camera and fusion settings in effect when they are not `config`'s own
+  // (replay: the log's rig, rig.h replayRig).
+  std::optional<Config> sensorConfig;
+  bool lossless = false;  // PipelineSetup::lossless (a log replayed as fast as possible)
 };
 
 // Fusion settings (camera calibration file, extrinsics, laser layers) of a config; a relative
 // calibration path is relative to the config file's folder. Throws std::runtime_error naming the
 // calibration file on failure.
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile);
+// The same with a camera model already read (replay: the log's camera.yaml).
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera);
 ServerLimits serverLimitsFrom(const Config& config);
 // Models resolve relative to the config file's folder.
 std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
@@ -62,6 +69,9 @@ class Service {
   bool alive(std::int64_t maxAgeNs) const;
   // One line for systemd's STATUS=.
   std::string summary() const;
+  // Every source is finite and has delivered everything, and the pipeline is idle: all results
+  // have reached the server (a replayed log at its end).
+  bool finished() const;
 
   Pipeline& pipeline() { return *pipeline_; }
   Server& server() { return *server_; }

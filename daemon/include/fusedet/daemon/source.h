@@ -1,11 +1,13 @@
 #pragma once
-// Source: one sensor input of the pipeline on its own thread - a live device driver (LMS 291
-// today; tilt motor and camera when their drivers land) or a replay of recorded data. A source
+// Source: one sensor input of the pipeline on its own thread - a live device driver (LMS 291,
+// tilt motor, camera) or a replay of recorded data (a sensor log, recorded scenes). A source
 // hands every message to its SensorSink, which never blocks (bounded, drop-oldest queue), and
 // reports its health for the `status` request.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,12 @@ class SensorSink {
   virtual void onTilt(drivers::TiltSample sample) = 0;
   virtual void onFrame(drivers::CameraFrame frame) = 0;
   virtual void onScene(PairedScene scene) = 0;
+  // End of a finite stream (a replayed log, or one pass of a looping one): the open sweep is
+  // closed and fused with its frame, and the sweep and pairing state start afresh.
+  virtual void onEndOfStream() = 0;
+  // Only for a source that loses nothing by waiting (a log replayed as fast as possible): returns
+  // once the next message can be taken without dropping anything, or when `stop` is set.
+  virtual void awaitRoom(const std::atomic<bool>& stop) = 0;
 };
 
 // What `status` reports per sensor.
@@ -41,6 +49,8 @@ struct SensorHealth {
   std::uint64_t reconnects = 0;
   std::uint64_t lost = 0;        // messages the device or source knows it lost
   std::string lastError;
+  std::optional<double> progress;  // replay: fraction of the log's messages replayed (this pass)
+  std::uint64_t passes = 0;        // replay: complete passes through the log
 };
 
 class Source {
@@ -51,6 +61,8 @@ class Source {
   // Stops and joins the thread; no sink call happens after it returns.
   virtual void stop() = 0;
   virtual std::vector<SensorHealth> health() const = 0;
+  // A finite source (a replayed log, recorded scenes) that has delivered everything it will.
+  virtual bool finished() const { return false; }
 };
 
 }  // namespace fusedet::daemon

@@ -1,0 +1,110 @@
+#include "fusedet/daemon/replay_source.h"
+
+#include <spdlog/spdlog.h>
+
+namespace fusedet::daemon {
+namespace {
+
+std::string describeDamage(const drivers::mcap::LogIndex& index) {
+  std::string out;
+  if (index.truncation) out = "log cut short: " + index.truncation->describe();
+  for (const std::string& p : index.problems) out += (out.empty() ? "" : "; ") + p;
+  return out;
+}
+
+}  // namespace
+
+ReplaySource::ReplaySource(ReplaySettings settings) : settings_(std::move(settings)) {
+  options_.realtime = settings_.realtime;
+  options_.speed = settings_.speed;
+  options_.restamp = settings_.restamp;
+  replay_ = std::make_unique<drivers::logs::SensorReplay>(settings_.log, settings_.sensors, options_);
+  const auto& index = replay_->source().index();
+  logMessages_ = index.messages;
+  damage_ = describeDamage(index);
+  if (!damage_.empty()) spdlog::warn("replay {}: {}; replaying what is intact", settings_.log.string(), damage_);
+}
+
+ReplaySource::~ReplaySource() { stop(); }
+
+void ReplaySource::start(SensorSink& sink) {
+  stop_ = false;
+  thread_ = std::thread([this, &sink] { run(sink); });
+}
+
+void ReplaySource::stop() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+}
+
+void ReplaySource::record(const drivers::logs::SensorReplayCounters& counters) {
+  std::lock_guard lock(mutex_);
+  pass_ = counters;
+}
+
+void ReplaySource::run(SensorSink& sink) {
+  std::uint64_t delivered = 0;
+  drivers::logs::SensorReplay::Handlers h;
+  h.scan = [&](const drivers::LaserScan& s) {
+    sink.onScan(s);
+    ++delivered;
+  };
+  h.tilt = [&](const drivers::TiltSample& t) {
+    sink.onTilt(t);
+    ++delivered;
+  };
+  h.frame = [&](const drivers::CameraFrame& f) {
+    sink.onFrame(f);
+    ++delivered;
+  };
+  for (;;) {
+    for (;;) {
+      // As fast as possible = as fast as the pipeline takes it: wait, never drop.
+      if (!settings_.realtime) sink.awaitRoom(stop_);
+      if (!replay_->step(h, &stop_)) break;
+      record(replay_->counters());
+      std::lock_guard lock(mutex_);
+      delivered_ = delivered;
+    }
+    if (stop_) return;
+    sink.onEndOfStream();
+    {
+      std::lock_guard lock(mutex_);
+      const auto pass = replay_->counters();
+      crcErrors_ += pass.telegrams.crcErrors;
+      lost_ += pass.lostScans + pass.badScans;
+      pass_ = {};
+      delivered_ = delivered;
+      ++passes_;
+    }
+    spdlog::info("replay {}: end of log (pass {})", settings_.log.string(), passes_);
+    if (!settings_.loop) break;
+    try {
+      replay_ = std::make_unique<drivers::logs::SensorReplay>(settings_.log, settings_.sensors, options_);
+    } catch (const std::exception& e) {
+      spdlog::error("replay {}: cannot reopen for the next pass: {}", settings_.log.string(), e.what());
+      std::lock_guard lock(mutex_);
+      error_ = e.what();
+      break;
+    }
+  }
+  finished_ = true;
+}
+
+std::vector<SensorHealth> ReplaySource::health() const {
+  SensorHealth h;
+  h.name = "replay";
+  h.state = finished_ ? "finished" : (stop_ ? "stopped" : "replaying");
+  std::lock_guard lock(mutex_);
+  h.messages = delivered_;
+  h.crcErrors = crcErrors_ + pass_.telegrams.crcErrors;  // finished passes + this one
+  h.lost = lost_ + pass_.lostScans + pass_.badScans;
+  h.lastError = error_.empty() ? damage_ : error_;
+  h.passes = passes_;
+  const auto& raw = pass_.raw;
+  const double read = static_cast<double>(raw.messages + raw.undecodable + raw.otherMessages);
+  h.progress = !settings_.loop && passes_ > 0 ? 1.0 : (logMessages_ ? std::min(1.0, read / static_cast<double>(logMessages_)) : 0.0);
+  return {h};
+}
+
+}  // namespace fusedet::daemon
