@@ -81,10 +81,14 @@ void SweepAssembler::process(bool final) {
 }
 
 void SweepAssembler::useScan(const drivers::LaserScan& scan, const std::vector<double>& tilt) {
-  const double change = tilt.back() - tilt.front();
+  const bool pause = hasOpen_ && scan.stamp - lastBeam_ > static_cast<std::int64_t>(config_.maxScanGapS * 1e9);
+  double change = tilt.back() - tilt.front();
+  // Interlaced LMS scans (0.5 and 0.25 deg modes) put every beam at the scan's stamp
+  // (beamDuration 0), so the tilt does not change inside them: the direction then comes from
+  // the tilt since the previous scan (without this the default 180/0.5 mode never closed a sweep).
+  if (std::abs(change) < config_.minTiltChange && lastTilt_ && !pause) change = tilt.back() - *lastTilt_;
   const int dir = std::abs(change) < config_.minTiltChange ? 0 : (change > 0 ? 1 : -1);
   const bool reversal = dir != 0 && direction_ != 0 && dir != direction_;
-  const bool pause = hasOpen_ && scan.stamp - lastBeam_ > static_cast<std::int64_t>(config_.maxScanGapS * 1e9);
   if (reversal || pause) closeSweep();
   if (dir != 0) direction_ = dir;
   if (!hasOpen_) {
@@ -114,6 +118,7 @@ void SweepAssembler::useScan(const drivers::LaserScan& scan, const std::vector<d
     open_.points.push_back(sp);
   }
   lastBeam_ = lastBeamStamp(scan);
+  lastTilt_ = tilt.back();
   open_.end = lastBeam_;
 }
 

@@ -39,13 +39,15 @@ Ray beamRay(double a, double t) {
 }
 
 // LMS-like scan: 181 beams over 180 deg (100 deg here to keep every beam on the wall).
-LaserScan wallScan(std::int64_t stampNs, const std::function<double(std::int64_t)>& tiltOf, std::uint64_t seq) {
+// interlaced: like the LMS's 0.5/0.25 deg modes, all beams carry the scan's stamp (beamDuration 0).
+LaserScan wallScan(std::int64_t stampNs, const std::function<double(std::int64_t)>& tiltOf, std::uint64_t seq,
+                   bool interlaced = false) {
   LaserScan s;
   s.stamp = Stamp{stampNs};
   s.sequence = seq;
   s.startAngle = 40 * kPi / 180;
   s.angleStep = 0.5 * kPi / 180;
-  s.beamDuration = (kScanNs / 2) * 1e-9 / 201;  // half a mirror turn covers the field of view
+  s.beamDuration = interlaced ? 0.0 : (kScanNs / 2) * 1e-9 / 201;  // half a mirror turn covers the field of view
   for (int i = 0; i < 201; ++i) {
     const Ray r = beamRay(s.beamAngle(static_cast<std::size_t>(i)), tiltOf(s.beamStamp(static_cast<std::size_t>(i)).ns));
     s.ranges.push_back(static_cast<float>((kWallX - r.ox) / r.dx));
@@ -71,7 +73,8 @@ SweepConfig wallConfig() {
 // Feeds tilt samples at 100 Hz from 20 ms before kT0 to 30 ms after `to` (so the last scan is
 // covered), and scans every 1/75 s from kT0 to `to`, in time order.
 void feed(SweepAssembler& a, std::int64_t to, const std::function<double(std::int64_t)>& tiltOf,
-          const std::function<bool(std::int64_t)>& tiltPresent = [](std::int64_t) { return true; }) {
+          const std::function<bool(std::int64_t)>& tiltPresent = [](std::int64_t) { return true; },
+          bool interlaced = false) {
   std::int64_t nextTilt = kT0 - 20'000'000, nextScan = kT0;
   std::uint64_t seq = 0;
   while (nextScan < to || nextTilt < to + 30'000'000) {
@@ -79,7 +82,7 @@ void feed(SweepAssembler& a, std::int64_t to, const std::function<double(std::in
       if (tiltPresent(nextTilt)) a.addTilt(TiltSample{Stamp{nextTilt}, tiltOf(nextTilt), 0});
       nextTilt += 10'000'000;
     } else {
-      a.addScan(wallScan(nextScan, tiltOf, seq++));
+      a.addScan(wallScan(nextScan, tiltOf, seq++, interlaced));
       nextScan += kScanNs;
     }
   }
@@ -153,6 +156,18 @@ TEST(SweepAssembler, SplitsAtTiltReversals) {
     EXPECT_LT(lo, -1.3f);  // 4 m * tan(20 deg) = 1.46 m, minus the start/end scans
     EXPECT_GT(hi, 1.3f);
   }
+}
+
+TEST(SweepAssembler, SplitsInterlacedScansAtTiltReversals) {
+  // No tilt change inside a scan: the direction must come from one scan to the next.
+  SweepAssembler a(wallConfig());
+  feed(a, kT0 + 1'980'000'000, triangle, [](std::int64_t) { return true; }, true);
+  a.flush();
+  const auto sweeps = a.takeSweeps();
+  ASSERT_EQ(sweeps.size(), 2u);
+  EXPECT_NEAR(static_cast<double>(sweeps[0].end.ns - kT0) * 1e-9, 1.0, 2 * kScanNs * 1e-9);
+  EXPECT_NEAR(static_cast<double>(sweeps[1].start.ns - kT0) * 1e-9, 1.0, 2 * kScanNs * 1e-9);
+  EXPECT_EQ(a.stats().scansUsed, a.stats().scans);
 }
 
 TEST(SweepAssembler, DropsAndCountsScansWithoutTiltNeverExtrapolates) {

@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "fusedet/drivers/messages.h"
@@ -77,6 +78,7 @@ class SweepAssembler {
   bool hasOpen_ = false;
   int direction_ = 0;  // +1 rising, -1 falling, 0 not yet known
   Stamp lastBeam_{};
+  std::optional<double> lastTilt_;  // tilt at the last used scan's last beam
   std::uint64_t nextId_ = 0;
   std::vector<Sweep> done_;
   SweepStats stats_;
