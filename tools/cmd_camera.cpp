@@ -184,11 +184,18 @@ int runGrab(const CameraOptions& o) {
   // The recording hook keeps the raw buffers; files are written after capturing, so slow disks
   // (or a slow emulated machine) never make the driver drop frames.
   std::vector<std::vector<std::uint8_t>> raws;
-  if (o.raw) camera.setRawHook([&raws](const RawBuffer& b) { raws.emplace_back(b.bytes.begin(), b.bytes.end()); });
+  // The hook also sees each buffer's own v4l2_buffer.sequence (the kernel's count); the last
+  // buffer it saw before readFrame returns is the returned frame's.
+  std::uint32_t kernelSequence = 0;
+  camera.setRawHook([&](const RawBuffer& b) {
+    kernelSequence = b.sequence;
+    if (o.raw) raws.emplace_back(b.bytes.begin(), b.bytes.end());
+  });
   auto info = camera.start();
   if (!info) return reportError("grab", o, info.error());
   for (const std::string& note : info->notes) std::fprintf(stderr, "fusedet camera grab: %s: %s\n", o.device.c_str(), note.c_str());
   std::vector<drivers::CameraFrame> frames;
+  std::vector<std::uint32_t> kernelSequences;
   const std::chrono::milliseconds timeout(o.timeoutMs);
   long restarts = 0;
   while (static_cast<long>(frames.size()) < o.count) {
@@ -198,6 +205,7 @@ int runGrab(const CameraOptions& o) {
       return reportError("grab", o, f.error());
     }
     frames.push_back(std::move(*f));
+    kernelSequences.push_back(kernelSequence);
     if (o.restartEvery > 0 && static_cast<long>(frames.size()) % o.restartEvery == 0 &&
         static_cast<long>(frames.size()) < o.count) {
       if (auto r = camera.restartStream(); !r) {
@@ -213,7 +221,7 @@ int runGrab(const CameraOptions& o) {
   json list = json::array();
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const drivers::CameraFrame& f = frames[i];
-    json j{{"sequence", f.sequence}, {"stamp", f.stamp.toString()}, {"bytes", f.bytes.size()}};
+    json j{{"sequence", f.sequence}, {"kernel_sequence", kernelSequences[i]}, {"stamp", f.stamp.toString()}, {"bytes", f.bytes.size()}};
     if (!o.out.empty()) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%04zu.png", i);
@@ -343,7 +351,7 @@ const bool registered = registerCommand(
       grab->add_option("--exposure", o->exposure, "auto, or a fixed exposure in microseconds")->capture_default_str();
       grab->add_option("--gain", o->gain, "auto, or a fixed gain in device units")->capture_default_str();
       grab->add_flag("--raw", o->raw, "also write each raw buffer as seen by the recording hook (buffer_NNNN.yuyv|.mjpg)");
-      grab->add_flag("--json", o->json, "print one JSON summary (format, interval, counters, frames[sequence, stamp, bytes, file])");
+      grab->add_flag("--json", o->json, "print one JSON summary (format, interval, counters, frames[sequence, kernel_sequence, stamp, bytes, file]); sequence = fusedet's count (continues across restarts), kernel_sequence = the driver's v4l2_buffer.sequence");
       CLI::App* stream = app.add_subcommand(
           "stream", "run the camera as the daemon does (restart a stalled stream, reopen a vanished device) and print frames until --count/--duration/Ctrl-C");
       stream->add_option("--device", o->device, "V4L2 capture node, e.g. /dev/video0")->required();
