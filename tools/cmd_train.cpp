@@ -41,6 +41,8 @@ struct TrainOptions {
   double minHeight = 25;
   int maxOcclusion = 1;
   bool noFlip = false;
+  int jitter = 0;
+  bool vanNegative = false;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -202,6 +204,8 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.samples.minPositiveHeight = o.minHeight;
   c.samples.maxOcclusion = o.maxOcclusion;
   c.samples.flipPositives = !o.noFlip;
+  c.samples.jitterCopies = o.jitter;
+  if (!o.vanNegative) c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
   c.samples.scan.scaleFactor = o.scaleFactor;
   c.samples.scan.step = o.step;
   c.stage.minHit = o.minHit;
@@ -344,6 +348,13 @@ const bool registered = registerCommand(
       app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
           ->capture_default_str();
       app.add_flag("--no-flip", o->noFlip, "do not add horizontally mirrored positives");
+      app.add_option("--jitter", o->jitter,
+                     "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "
+                     "scaled by up to +-5 %")
+          ->capture_default_str();
+      app.add_flag("--van-negative", o->vanNegative,
+                   "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
+                   "negative windows on them)");
       app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
           ->capture_default_str();
       app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")

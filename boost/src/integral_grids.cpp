@@ -17,6 +17,7 @@ namespace {
 struct Source {
   cv::Mat data;
   std::optional<double> hueReference;  // set: data is hue (CV_32F), the slot is hue_distance
+  cv::Mat hueValid;                     // the hue layer's mask (empty = every pixel has a hue)
 };
 
 // Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum.
@@ -35,11 +36,13 @@ void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
   }
 }
 
-void integrateHueDistance(const cv::Mat& hue, double reference, double* slot0, std::ptrdiff_t pitch) {
+void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, double* slot0,
+                          std::ptrdiff_t pitch) {
   const int w = hue.cols, h = hue.rows;
   std::vector<float> dist(static_cast<std::size_t>(w));
   for (int y = 0; y < h; ++y) {
-    hueDistanceRow(hue.ptr<float>(y), dist.data(), w, reference);
+    hueDistanceRow(hue.ptr<float>(y), valid.empty() ? nullptr : valid.ptr<unsigned char>(y), dist.data(), w,
+                   reference);
     const double* prev = slot0 + y * pitch;
     double* cur = slot0 + (y + 1) * pitch;
     double rowSum = 0;
@@ -56,7 +59,7 @@ bool fitsInt32(const cv::Mat& data) {
 }
 
 void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
-  if (s.hueReference) return integrateHueDistance(s.data, *s.hueReference, slot0, pitch);
+  if (s.hueReference) return integrateHueDistance(s.data, s.hueValid, *s.hueReference, slot0, pitch);
   switch (s.data.depth()) {
     case CV_8U: return integrateSlot<std::uint8_t>(s.data, slot0, pitch);
     case CV_16U: return integrateSlot<std::uint16_t>(s.data, slot0, pitch);
@@ -120,6 +123,7 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
       src.data = stack.at(layer::kHue).data;
       if (src.data.type() != CV_32FC1) src.data.convertTo(src.data, CV_32F);
       src.hueReference = r.referenceHue;
+      src.hueValid = stack.at(layer::kHue).valid;
     } else {
       if (!l) stack.at(r.name);  // throws, naming the missing layer and the ones present
       if (l->data.channels() != 1 || l->data.empty())

@@ -70,9 +70,10 @@ IntegralStack::IntegralStack(const LayerStack& stack, std::span<const std::strin
     if (!l && name == layer::kHueDistance && stack.has(layer::kHue)) {
       if (!referenceHue)
         throw std::invalid_argument("IntegralStack: layer 'hue_distance' needs a reference hue");
-      cv::Mat hue = stack.at(layer::kHue).data;
+      const Layer& hueLayer = stack.at(layer::kHue);
+      cv::Mat hue = hueLayer.data;
       if (hue.type() != CV_32FC1) hue.convertTo(hue, CV_32F);
-      layers_.push_back(integrateLayer(name, hueDistanceLayer(hue, *referenceHue), squared));
+      layers_.push_back(integrateLayer(name, hueDistanceLayer(hue, hueLayer.valid, *referenceHue), squared));
       continue;
     }
     if (!l) stack.at(name);  // throws, naming the missing layer and the ones present

@@ -46,4 +46,32 @@ double HueHistogram::referenceHue() const {
   return (best + 0.5) * (360.0 / kHueBins);
 }
 
+double HueHistogram::distinctiveHue(const HueHistogram& background, double minShare) const {
+  if (total_ <= 0) throw std::runtime_error("reference hue: no hue values inside the positive boxes");
+  if (background.total() <= 0) throw std::runtime_error("reference hue: no hue values in the training images");
+  const auto c = smoothed(), b = background.smoothed();
+  int best = -1;
+  double bestRatio = 0;
+  for (int i = 0; i < kHueBins; ++i) {
+    const double share = c[i] / total_;
+    if (share < minShare) continue;
+    const double ratio = share / (b[i] / background.total() + 1e-3);
+    if (best < 0 || ratio > bestRatio) best = i, bestRatio = ratio;
+  }
+  if (best < 0) return referenceHue();  // no bin holds minShare: spread evenly, take the mode
+  return (best + 0.5) * (360.0 / kHueBins);
+}
+
+void HueHistogram::addImage(const LayerStack& stack, int stride) {
+  const Layer& hue = stack.at(layer::kHue);
+  const int s = std::max(1, stride);
+  cv::Mat h;
+  hue.data.convertTo(h, CV_64F);
+  for (int y = 0; y < hue.height(); y += s)
+    for (int x = 0; x < hue.width(); x += s) {
+      if (hue.hasMask() && !hue.valid.at<std::uint8_t>(y, x)) continue;
+      addHue(h.at<double>(y, x));
+    }
+}
+
 }  // namespace fusedet::boosting

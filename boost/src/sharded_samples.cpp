@@ -10,27 +10,31 @@ namespace fusedet::boosting {
 
 double shardedReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, Shard shard,
                            Collective& job) {
-  HueHistogram mine;
+  HueHistogram mine, mineBackground;
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (!shard.owns(i)) continue;
-    for (const Label& l : items[i].labels)
-      if (isPositiveLabel(l, samples)) {
-        try {
-          mine.add(items[i].stack, l.box);
-        } catch (const std::out_of_range& e) {
-          throw std::runtime_error("reference hue: item " + items[i].id + ": " + e.what());
-        }
-      }
+    try {
+      for (const Label& l : items[i].labels)
+        if (isPositiveLabel(l, samples)) mine.add(items[i].stack, l.box);
+      mineBackground.addImage(items[i].stack);
+    } catch (const std::out_of_range& e) {
+      throw std::runtime_error("reference hue: item " + items[i].id + ": " + e.what());
+    }
   }
   // Bins hold pixel counts (weight 1 each): integers, summed exactly in any order.
-  std::vector<std::int64_t> counts(kHueBins);
-  for (int b = 0; b < kHueBins; ++b) counts[static_cast<std::size_t>(b)] = static_cast<std::int64_t>(mine.bins()[b]);
+  std::vector<std::int64_t> counts(2 * kHueBins);
+  for (int b = 0; b < kHueBins; ++b) {
+    counts[static_cast<std::size_t>(b)] = static_cast<std::int64_t>(mine.bins()[b]);
+    counts[static_cast<std::size_t>(kHueBins + b)] = static_cast<std::int64_t>(mineBackground.bins()[b]);
+  }
   job.allReduceSum(counts);
-  HueHistogram all;
-  for (int b = 0; b < kHueBins; ++b)
-    if (counts[static_cast<std::size_t>(b)] > 0)
-      all.addHue((b + 0.5) * (360.0 / kHueBins), double(counts[static_cast<std::size_t>(b)]));
-  return all.referenceHue();
+  HueHistogram all, background;
+  for (int b = 0; b < kHueBins; ++b) {
+    const double centre = (b + 0.5) * (360.0 / kHueBins);
+    if (const auto n = counts[static_cast<std::size_t>(b)]; n > 0) all.addHue(centre, double(n));
+    if (const auto n = counts[static_cast<std::size_t>(kHueBins + b)]; n > 0) background.addHue(centre, double(n));
+  }
+  return all.distinctiveHue(background);
 }
 
 namespace {

@@ -13,15 +13,40 @@ bool isPositiveLabel(const Label& label, const SampleConfig& c) {
          label.occlusion <= c.maxOcclusion && label.box.w > 0;
 }
 
+bool isIgnoredLabel(const Label& label, const SampleConfig& c) {
+  if (label.ignore) return true;
+  if (label.className == c.className) return !isPositiveLabel(label, c);
+  return std::find(c.ignoreClasses.begin(), c.ignoreClasses.end(), label.className) != c.ignoreClasses.end();
+}
+
+std::vector<std::string> neighbourClasses(const std::string& className) {
+  if (className == "car") return {"van"};
+  return {};
+}
+
 bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& c) {
   for (const Label& l : labels) {
-    if (l.ignore) {
-      if (coverage(window, l.box) > c.maxIgnoreCoverage) return false;
+    if (isIgnoredLabel(l, c)) {
+      if (coverage(window, l.box) > c.maxIgnoreCoverage || coverage(l.box, window) > c.maxIgnoreCoverage)
+        return false;
     } else if (l.className == c.className && iou(window, l.box) >= c.maxNegativeIou) {
       return false;
     }
   }
   return true;
+}
+
+std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double scale, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Box> out;
+  for (int i = 0; i < copies; ++i) {
+    // Draw order fixed (scale, dx, dy) so that the copies are the same on every platform's libstdc++.
+    const double s = 1.0 + scale * unit(rng);
+    const double dx = shift * box.w * unit(rng), dy = shift * box.h * unit(rng);
+    const double w = box.w * s, h = box.h * s;
+    out.push_back(Box{box.x + box.w / 2 + dx - w / 2, box.y + box.h / 2 + dy - h / 2, w, h});
+  }
+  return out;
 }
 
 DatasetItem flipItem(const DatasetItem& item) {
@@ -48,6 +73,7 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                const std::vector<std::string>& layers,
                                std::optional<double> referenceHue, const SampleConfig& config, Shard shard)
     : config_(config), shard_(shard) {
+  std::mt19937_64 rng(config_.jitterSeed);
   auto addStack = [&](const DatasetItem& item, std::size_t itemIndex) {
     const auto index = static_cast<std::uint32_t>(integrals_.size());
     const bool mine = shard_.owns(itemIndex);
@@ -59,7 +85,12 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
     owner_.push_back(static_cast<int>(itemIndex % static_cast<std::size_t>(shard_.ranks)));
     labels_.push_back(item.labels);
     for (const Label& l : item.labels)
-      if (isPositiveLabel(l, config_)) positives_.push_back(Sample{index, l.box});
+      if (isPositiveLabel(l, config_)) {
+        positives_.push_back(Sample{index, l.box});
+        // Windows reaching over the border are clamped into the layer, as the labels' own are.
+        for (const Box& b : jitteredBoxes(l.box, config_.jitterCopies, config_.jitterShift, config_.jitterScale, rng))
+          positives_.push_back(Sample{index, b});
+      }
   };
   for (std::size_t i = 0; i < items.size(); ++i) addStack(items[i], i);
   originals_ = integrals_.size();

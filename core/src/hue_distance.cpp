@@ -19,6 +19,24 @@ void hueDistanceRow(const float* in, float* o, int n, double referenceDeg) {
   }
 }
 
+void hueDistanceRow(const float* in, const unsigned char* valid, float* o, int n, double referenceDeg) {
+  hueDistanceRow(in, o, n, referenceDeg);
+  if (valid)
+    for (int x = 0; x < n; ++x)
+      if (!valid[x]) o[x] = kNoHueDistance;
+}
+
+cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, const cv::Mat& valid, double referenceDeg) {
+  if (valid.empty()) return hueDistanceLayer(hueDeg, referenceDeg);
+  if (hueDeg.type() != CV_32FC1) throw std::invalid_argument("hueDistanceLayer: hue must be CV_32FC1 degrees");
+  if (valid.type() != CV_8UC1 || valid.size() != hueDeg.size())
+    throw std::invalid_argument("hueDistanceLayer: mask must be CV_8UC1 of the hue's size");
+  cv::Mat out(hueDeg.size(), CV_32FC1);
+  for (int y = 0; y < hueDeg.rows; ++y)
+    hueDistanceRow(hueDeg.ptr<float>(y), valid.ptr<unsigned char>(y), out.ptr<float>(y), hueDeg.cols, referenceDeg);
+  return out;
+}
+
 cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, double referenceDeg) {
   if (hueDeg.type() != CV_32FC1) throw std::invalid_argument("hueDistanceLayer: hue must be CV_32FC1 degrees");
   cv::Mat out(hueDeg.size(), CV_32FC1);

@@ -43,7 +43,23 @@ cv::Mat hueDegrees(const cv::Mat& bgr) {
   return hue;
 }
 
-void addCameraLayers(LayerStack& stack, const cv::Mat& bgr) {
+cv::Mat hueValidMask(const cv::Mat& bgr, const HueMaskRule& rule) {
+  if (bgr.type() != CV_8UC3) throw std::invalid_argument("hueValidMask: image must be 8-bit BGR");
+  cv::Mat valid(bgr.size(), CV_8UC1);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const std::uint8_t* p = bgr.ptr<std::uint8_t>(y);
+    std::uint8_t* v = valid.ptr<std::uint8_t>(y);
+    for (int x = 0; x < bgr.cols; ++x, p += 3) {
+      const int mx = std::max({p[0], p[1], p[2]}), mn = std::min({p[0], p[1], p[2]});
+      // Saturation (max - min) / max >= minSaturation, without a division.
+      const bool coloured = mx >= rule.minValue && double(mx - mn) >= rule.minSaturation * double(mx) && mx > mn;
+      v[x] = coloured ? 255 : 0;
+    }
+  }
+  return valid;
+}
+
+void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& hueRule) {
   if (bgr.type() != CV_8UC3) throw std::invalid_argument("addCameraLayers: image must be 8-bit BGR");
   stack.setReferenceSize(bgr.cols, bgr.rows);
   cv::Mat channels[3];
@@ -54,7 +70,7 @@ void addCameraLayers(LayerStack& stack, const cv::Mat& bgr) {
   stack.set(Layer{std::string(layer::kGreen), channels[1], {}});
   stack.set(Layer{std::string(layer::kBlue), channels[0], {}});
   stack.set(Layer{std::string(layer::kIntensity), gray, {}});
-  stack.set(Layer{std::string(layer::kHue), hueDegrees(bgr), {}});
+  stack.set(Layer{std::string(layer::kHue), hueDegrees(bgr), hueValidMask(bgr, hueRule)});
 }
 
 }  // namespace fusedet::fusion

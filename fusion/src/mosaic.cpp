@@ -118,7 +118,7 @@ cv::Mat renderMosaic(const LayerStack& stack, const Labels& labels, const std::v
     if (const Layer* hue = stack.find(layer::kHue); hue && hue->data.type() == CV_32FC1) {
       char caption[96];
       std::snprintf(caption, sizeof caption, "hue_distance to %.0f deg", *o.hueReference);
-      cv::Mat d = hueDistanceLayer(hue->data, *o.hueReference), g8, bgr;
+      cv::Mat d = hueDistanceLayer(hue->data, hue->valid, *o.hueReference), g8, bgr;
       d.convertTo(g8, CV_8U, 255.0 / 180.0);
       cv::cvtColor(g8, bgr, cv::COLOR_GRAY2BGR);
       tiles.emplace_back(caption, bgr);

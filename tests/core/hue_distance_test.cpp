@@ -23,3 +23,19 @@ TEST(HueDistance, LayerMatchesScalarAcrossTheWrap) {
   EXPECT_NEAR(d.at<float>(0, 2), 165.f, 1e-4);  // 185 vs 350
   EXPECT_THROW((void)fusedet::hueDistanceLayer(cv::Mat(2, 2, CV_8UC1), 0), std::invalid_argument);
 }
+
+TEST(HueDistance, PixelsWithoutHueAreNeutral) {
+  cv::Mat hue(1, 3, CV_32FC1);
+  hue.at<float>(0, 0) = 0.f;    // "red" only because the pixel was grey
+  hue.at<float>(0, 1) = 10.f;
+  hue.at<float>(0, 2) = 200.f;
+  cv::Mat valid(1, 3, CV_8UC1, cv::Scalar(255));
+  valid.at<unsigned char>(0, 0) = 0;
+  const cv::Mat d = fusedet::hueDistanceLayer(hue, valid, 0.0);
+  EXPECT_EQ(d.at<float>(0, 0), 90.f);  // not 0: a grey pixel is not the class's red
+  EXPECT_NEAR(d.at<float>(0, 1), 10.f, 1e-4);
+  EXPECT_NEAR(d.at<float>(0, 2), 160.f, 1e-4);
+  const cv::Mat all = fusedet::hueDistanceLayer(hue, cv::Mat(), 0.0);
+  EXPECT_EQ(all.at<float>(0, 0), 0.f);
+  EXPECT_THROW((void)fusedet::hueDistanceLayer(hue, cv::Mat(2, 2, CV_8UC1), 0.0), std::invalid_argument);
+}

@@ -151,6 +151,47 @@ TEST(CascadeTrainer, NegativeWindowsAvoidLabelsAndIgnoreRegions) {
   EXPECT_FALSE(isPositiveLabel(small, s));
 }
 
+TEST(CascadeTrainer, WindowsHoldingAnIgnoredLabelAreNoNegatives) {
+  SampleConfig s;
+  Labels labels(2);
+  labels[0].className = "car";  // below 25 px: neither positive nor background
+  labels[0].box = Box{100, 100, 30, 20};
+  labels[1].className = "van";
+  labels[1].box = Box{300, 100, 40, 30};
+  ASSERT_TRUE(isIgnoredLabel(labels[0], s));
+  // A window 2x larger than the small car, holding all of it: IoU 0.25 < 0.3, yet no negative.
+  EXPECT_FALSE(isNegativeWindow(Box{85, 90, 60, 40}, labels, s));
+  // 3x larger: IoU 0.11, still holds the whole car.
+  EXPECT_FALSE(isNegativeWindow(Box{70, 80, 90, 60}, labels, s));
+  // Holding a third of it: a negative.
+  EXPECT_TRUE(isNegativeWindow(Box{120, 100, 30, 20}, labels, s));
+  // The van is background unless listed as a neighbouring class (KITTI's devkit ignores it).
+  EXPECT_TRUE(isNegativeWindow(Box{290, 95, 60, 40}, labels, s));
+  s.ignoreClasses = neighbourClasses("car");
+  EXPECT_EQ(s.ignoreClasses, std::vector<std::string>{"van"});
+  EXPECT_FALSE(isNegativeWindow(Box{290, 95, 60, 40}, labels, s));
+  EXPECT_TRUE(neighbourClasses("person").empty());
+}
+
+TEST(CascadeTrainer, JitteredPositivesStayNearTheirLabel) {
+  std::mt19937_64 rng(5), again(5);
+  const Box b{100, 50, 40, 20};
+  const std::vector<Box> j = jitteredBoxes(b, 50, 0.05, 0.05, rng);
+  ASSERT_EQ(j.size(), 50u);
+  bool moved = false;
+  for (const Box& x : j) {
+    EXPECT_LE(std::abs(x.w / b.w - 1), 0.05 + 1e-12);
+    EXPECT_NEAR(x.w / x.h, 2.0, 1e-12);  // aspect kept
+    EXPECT_LE(std::abs(x.x + x.w / 2 - 120), 0.05 * 40 + 1e-9);
+    EXPECT_LE(std::abs(x.y + x.h / 2 - 60), 0.05 * 20 + 1e-9);
+    EXPECT_GT(iou(x, b), 0.8);
+    moved = moved || std::abs(x.x - b.x) > 0.1;
+  }
+  EXPECT_TRUE(moved);
+  const std::vector<Box> k = jitteredBoxes(b, 50, 0.05, 0.05, again);
+  EXPECT_EQ(k.front().x, j.front().x);  // seeded: the same copies
+}
+
 TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
   // Two layers at different resolutions; windows of repeated and distinct sizes.
   std::vector<DatasetItem> items;

@@ -40,3 +40,28 @@ TEST(ReferenceHue, ReadsTheHueLayerInsideABoxAtItsOwnResolution) {
   LayerStack noHue(10, 10);
   EXPECT_THROW(h.add(noHue, Box{0, 0, 5, 5}), std::out_of_range);
 }
+
+TEST(ReferenceHue, DistinctiveHueIsWhatTheClassHasAndTheBackgroundLacks) {
+  // Class pixels: 60 % bluish grey (215, like the whole street), 40 % red (5). The mode is 215;
+  // the distinctive hue is red, which the background seldom has.
+  HueHistogram cls, bg;
+  cls.addHue(215, 60);
+  cls.addHue(5, 40);
+  bg.addHue(215, 900);
+  bg.addHue(5, 10);
+  bg.addHue(100, 90);
+  EXPECT_DOUBLE_EQ(cls.referenceHue(), 215.0);
+  EXPECT_DOUBLE_EQ(cls.distinctiveHue(bg), 5.0);
+  // A bin with less than minShare of the class never wins, however rare in the background.
+  cls.addHue(300, 1);
+  EXPECT_DOUBLE_EQ(cls.distinctiveHue(bg), 5.0);
+  EXPECT_THROW((void)cls.distinctiveHue(HueHistogram()), std::runtime_error);
+  // addImage skips pixels the mask marks as hue-less.
+  LayerStack s(4, 4);
+  cv::Mat valid(4, 4, CV_8U, cv::Scalar(0));
+  valid.at<std::uint8_t>(0, 0) = 255;
+  s.set(Layer{"hue", cv::Mat(4, 4, CV_32F, cv::Scalar(120.f)), valid});
+  HueHistogram img;
+  img.addImage(s, 1);
+  EXPECT_DOUBLE_EQ(img.total(), 1.0);
+}

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -27,10 +28,22 @@ struct SampleConfig {
   double minPositiveHeight = 25;  // reference pixels
   int maxOcclusion = 1;
   bool flipPositives = true;
-  // A window is a negative candidate when IoU < maxNegativeIou with every label of the class
-  // (positive or not) and it lies in no ignore region by more than maxIgnoreCoverage of its area.
+  // Jittered copies of every positive (and of its mirrored copy): the box shifted by up to
+  // jitterShift of its width/height and scaled by up to 1 +- jitterScale, drawn with jitterSeed.
+  // They teach the small misalignments the detector's scan grid and the labels have.
+  int jitterCopies = 0;
+  double jitterShift = 0.05;
+  double jitterScale = 0.05;
+  std::uint64_t jitterSeed = 7;
+  // A window is a negative candidate when IoU < maxNegativeIou with every positive of the class
+  // and it overlaps no ignored label by more than maxIgnoreCoverage of the window's area or of the
+  // label's area. Ignored labels: ignore regions (DontCare, ...), labels of the class that are not
+  // positives (too small, too occluded) and labels of `ignoreClasses`; evaluation neither counts
+  // a detection on them as a hit nor as a false alarm, so a window holding most of one (even a
+  // window 2-3x larger than the object) must not be taught as background.
   double maxNegativeIou = 0.3;
   double maxIgnoreCoverage = 0.5;
+  std::vector<std::string> ignoreClasses;  // e.g. {"van"} for car: KITTI's neighbouring class
   int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
   ScanParams scan;            // windows scanned for negatives (scales, step)
 };
@@ -42,6 +55,10 @@ struct Sample {
 
 // Does `label` become a positive of `config.className`?
 bool isPositiveLabel(const Label& label, const SampleConfig& config);
+// Is `label` neither a positive nor background for config.className (see SampleConfig)?
+bool isIgnoredLabel(const Label& label, const SampleConfig& config);
+// The classes KITTI's devkit ignores next to `className` ("van" for "car"); empty for others.
+std::vector<std::string> neighbourClasses(const std::string& className);
 // May `window` of a stack with `labels` serve as a negative?
 bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& config);
 
@@ -104,6 +121,9 @@ class TrainingStacks {
   SampleConfig config_;
   Shard shard_;
 };
+
+// `copies` jittered versions of `box` (SampleConfig's jitter rule), drawn from `rng`.
+std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double scale, std::mt19937_64& rng);
 
 // Horizontally mirrored copy of a stack (every layer and mask) and its labels.
 DatasetItem flipItem(const DatasetItem& item);

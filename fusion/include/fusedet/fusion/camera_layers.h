@@ -12,8 +12,20 @@ namespace fusedet::fusion {
 // conversion (0 where the pixel is grey: max == min).
 cv::Mat hueDegrees(const cv::Mat& bgr);
 
+// Which pixels carry a hue: grey, dark and washed-out pixels have none worth comparing (their
+// hue is noise, and 0 would read as red). HSV saturation (max - min) / max >= minSaturation
+// and value max >= minValue (0-255).
+struct HueMaskRule {
+  double minSaturation = 0.2;
+  int minValue = 40;
+};
+// CV_8UC1: 255 where the pixel has a hue by `rule`, 0 elsewhere.
+cv::Mat hueValidMask(const cv::Mat& bgr, const HueMaskRule& rule = {});
+
 // Adds red, green, blue, intensity (ITU-R BT.601 luma, as cv::COLOR_BGR2GRAY) and hue to `stack`
-// and sets its reference size to the image. bgr: CV_8UC3.
-void addCameraLayers(LayerStack& stack, const cv::Mat& bgr);
+// and sets its reference size to the image. bgr: CV_8UC3. The hue layer's validity mask is
+// hueValidMask(bgr, hueRule): hue_distance gives masked pixels the neutral 90 degrees
+// (core/hue_distance.h) and the reference hue counts only valid ones.
+void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& hueRule = {});
 
 }  // namespace fusedet::fusion

@@ -1,7 +1,8 @@
 #pragma once
 // Fuser: one camera image + one sweep -> a LayerStack with the camera layers (red, green, blue,
 // intensity, hue) at image resolution and the laser layers (distance, remission, with a validity
-// mask) at their own lower resolution, registered through the undistorted image plane.
+// mask) at their own lower resolution, registered through the undistorted image plane; with
+// ProjectionConfig::extraChannels also the channels of channel_layers.h.
 // The same code serves live data (distorted camera, extrinsics from config) and KITTI (rectified
 // camera, calib files).
 
@@ -17,7 +18,7 @@ namespace fusedet::fusion {
 
 // Wall time of each step of one fuse() call, in milliseconds.
 struct FuseTimings {
-  double undistortMs = 0, cameraLayersMs = 0, projectMs = 0, rasteriseMs = 0, totalMs = 0;
+  double undistortMs = 0, cameraLayersMs = 0, projectMs = 0, rasteriseMs = 0, channelsMs = 0, totalMs = 0;
 };
 
 class Fuser {
