@@ -1,8 +1,10 @@
-// Sensor-stamp-to-socket latency of the whole daemon: real KITTI scenes (Velodyne turn + camera
-// image) played into a running Service at a fixed period, fused, run through every bundled class
-// cascade and received by a socket client, which measures (receive time - sensor stamp). Beside
+// Sensor-stamp-to-socket latency of the whole daemon replaying a sensor log: a log synthesised
+// from held-back KITTI frames (raw LMS telegrams, CANopen tilt traffic, YUYV camera frames) is
+// replayed at recorded speed and re-stamped to "now" (as if the sensors were live) into a running
+// Service - live decoders, sweep assembly, pairing, fusion, the car, bike and person cascades, the
+// socket server - and a socket client measures (receive time - sensor stamp of the stack). Beside
 // it, on the same stacks in the same run: the pipeline's pure compute (fuse + detect), the floor
-// any queueing and socket overhead adds to.
+// any queueing, sweep closing and socket overhead adds to.
 
 #include <unistd.h>
 
@@ -12,77 +14,87 @@
 #include <thread>
 
 #include "fusedet/daemon/client.h"
-#include "fusedet/daemon/kitti_scenes.h"
-#include "fusedet/daemon/scene_source.h"
 #include "fusedet/daemon/service.h"
+#include "fusedet/daemon/service_parts.h"
 #include "fusedet/daemon/stats.h"
+#include "fusedet/fusion/synth_log.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
+namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
-  CLI::App app{"bench_daemon_latency - sensor stamp to socket client latency of fusedetd's pipeline"};
-  std::string data = FUSEDET_DATA_DIR, models = FUSEDET_SOURCE_DIR "/models";
-  int frames = 6, rounds = 5, periodMs = 200, threads = 0;
-  app.add_option("--data", data, "root of the shared data")->capture_default_str();
+  CLI::App app{"bench_daemon_latency - sensor stamp to socket client latency of fusedetd replaying a sensor log"};
+  std::string data = FUSEDET_DATA_DIR, models = FUSEDET_SOURCE_DIR "/models", log;
+  int frames = 6, passes = 3, threads = 0;
+  double speed = 1.0;
+  app.add_option("--data", data, "root of the shared data (the log is made from its kitti/ folder)")->capture_default_str();
   app.add_option("--models", models, "folder with car.json, bike.json, person.json")->capture_default_str();
-  app.add_option("--frames", frames, "KITTI frames (held-back third of drive kitti)")->capture_default_str();
-  app.add_option("--rounds", rounds, "times the frames are played")->capture_default_str();
-  app.add_option("--period-ms", periodMs, "one scene every this many ms")->capture_default_str();
+  app.add_option("--log", log, "replay this sensor log instead of synthesising one");
+  app.add_option("--frames", frames, "strokes of the synthesised log (one held-back KITTI frame each)")->capture_default_str();
+  app.add_option("--passes", passes, "times the log is replayed")->capture_default_str();
+  app.add_option("--speed", speed, "replay speed (1 = as recorded)")->capture_default_str();
   app.add_option("--threads", threads, "detection threads (0 = all cores)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
-  const auto root = std::filesystem::path(data) / "kitti";
-  auto ids = fusion::listKittiFrames(root);
-  std::vector<std::string> chosen;
-  for (std::size_t i = ids.size() * 2 / 3; i < ids.size() && chosen.size() < static_cast<std::size_t>(frames); ++i)
-    chosen.push_back(ids[i]);
-  auto scenes = loadKittiScenes(root, chosen);
+  const fs::path tmp = fs::temp_directory_path() / ("fusedet-bench-" + std::to_string(::getpid()));
+  fs::create_directories(tmp);
+  std::string scene = "log " + log;
+  if (log.empty()) {
+    fusion::SynthOptions synth;
+    if (fs::exists(fs::path(data) / "kitti" / "velodyne")) synth.kitti = fs::path(data) / "kitti";
+    synth.frames = frames;
+    log = (tmp / "bench.mcap").string();
+    const fusion::SynthReport r = fusion::synthesizeLog(synth, log);
+    scene = "synthesised " + r.scene + ", " + std::to_string(r.frameIds.size()) + " strokes of " +
+            std::to_string(r.strokeS).substr(0, 5) + " s";
+  }
 
   Config config;
-  config.socket.path = (std::filesystem::temp_directory_path() / ("fusedet-bench-" + std::to_string(::getpid()) + ".sock")).string();
+  config.socket.path = (tmp / "bench.sock").string();
   config.detection.models = {models + "/car.json", models + "/bike.json", models + "/person.json"};
   config.detection.threads = threads;
-  ServiceParts parts;
-  parts.config = config;
-  parts.fuser = scenes.fuser;
-  parts.detector = detectorFrom(config, {});
-  auto source = std::make_unique<SceneSource>(scenes.scenes, std::chrono::milliseconds(periodMs), static_cast<std::size_t>(rounds));
-  SceneSource* src = source.get();
-  parts.sources.push_back(std::move(source));
+  config.replay.file = log;
+  config.replay.realtime = true;
+  config.replay.speed = speed;
+  config.replay.restamp = true;  // stamps = when the sensor would have measured: latencies are real
+  config.replay.atEnd = "loop";
+  ServiceParts parts = replayParts(config, {});
   parts.listener = bindUnixSocket(config.socket.path);
-  parts.mode = "scenes";
   Service service(std::move(parts));
-  service.start();
-
   Client client(config.socket.path);
   client.send({{"cmd", "subscribe"}});
+  service.start();
+
   std::vector<double> latency, compute;
-  const std::size_t expected = chosen.size() * static_cast<std::size_t>(rounds);
+  std::uint64_t lastStack = UINT64_MAX;  // the last stack of the last pass, once fusion has flushed it
   while (true) {
-    auto line = client.readLine(std::chrono::seconds(20));
+    auto line = client.readLine(std::chrono::seconds(30));
     if (!line) break;
     const Stamp received = Stamp::now();
     const auto m = nlohmann::json::parse(*line);
     if (m["type"] != "detections") continue;
     latency.push_back(static_cast<double>(received.ns - m["sensor_ns"].get<std::int64_t>()) * 1e-6);
     compute.push_back(m["fuse_ms"].get<double>() + m["detect_ms"].get<double>());
-    const auto c = service.pipeline().counters();
-    if (src->finished() && c.stacksDetected + c.stackQueue.dropped >= expected && latency.size() >= c.stacksDetected) break;
+    const auto pc = service.pipeline().counters();
+    if (lastStack == UINT64_MAX && pc.streamEnds >= static_cast<std::uint64_t>(passes)) lastStack = pc.stacksFused - 1;
+    if (m["stack"].get<std::uint64_t>() >= lastStack) break;
   }
   const auto c = service.pipeline().counters();
+  const auto status = service.status();
   service.stop(std::chrono::steady_clock::now() + std::chrono::milliseconds(1500));
-  std::remove(config.socket.path.c_str());
+  fs::remove_all(tmp);
 
   double load = 0;
   std::ifstream("/proc/loadavg") >> load;
-  std::printf("daemon latency: %zu KITTI frames x %d rounds, one scene every %d ms, classes car bike person, "
+  std::printf("daemon latency, replay: %s; %d passes at %.2fx recorded speed, re-stamped; classes car bike person, "
               "detection threads %d (0 = all), %u cores, load average %.2f\n",
-              chosen.size(), rounds, periodMs, threads, std::thread::hardware_concurrency(), load);
-  std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind)\n",
-              latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped));
+              scene.c_str(), passes, speed, threads, std::thread::hardware_concurrency(), load);
+  std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind), %llu unpaired sweeps\n",
+              latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),
+              static_cast<unsigned long long>(c.unpaired));
   if (latency.empty()) {
-    std::fprintf(stderr, "bench_daemon_latency: no stack reached the client\n");
+    std::fprintf(stderr, "bench_daemon_latency: no stack reached the client: %s\n", status.dump().c_str());
     return 1;
   }
   std::printf("%-44s p50 %8.1f  p90 %8.1f  p99 %8.1f  max %8.1f ms\n", "sensor stamp -> socket client (ours)",

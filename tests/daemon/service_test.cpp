@@ -1,6 +1,7 @@
 // The whole daemon in-process on real KITTI scenes: scene source -> fusion -> the bundled
 // cascades -> socket clients. Checks what clients receive (every stack, positions that agree with
-// KITTI's own 3D labels), reload under load, liveness for the watchdog and shutdown timing.
+// KITTI's own 3D labels), reload under load (replaying a sensor log), liveness for the watchdog
+// and shutdown timing.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -13,6 +14,8 @@
 #include "fusedet/daemon/scene_source.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/kitti_scenes.h"
+#include "fusedet/daemon/service_parts.h"
+#include "replay_logs.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -149,10 +152,15 @@ TEST(Service, ClientsGetEveryStackWithPositionsMatchingKittiLabels) {
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
 }
 
+// On a replaying daemon: the test log looped as fast as detection goes (a steady stream of stacks).
 TEST(Service, ReloadUnderLoadKeepsClientsAndABadFileKeepsTheOldModels) {
-  const auto k = loadKittiScenes(kittiRoot(), {"000105"});
-  const Config config = testConfig(tempSocket("reload.sock"));
-  Service service(parts(config, k, std::make_unique<SceneSource>(k.scenes, 150ms, 0)));
+  Config config = testConfig(tempSocket("reload.sock"));
+  config.replay.file = testlogs::daemonTestLog(3).string();
+  config.replay.realtime = false;
+  config.replay.atEnd = "loop";
+  ServiceParts replaying = replayParts(config, {});
+  replaying.listener = bindUnixSocket(config.socket.path);
+  Service service(std::move(replaying));
   service.start();
   std::vector<std::unique_ptr<Client>> clients;
   for (int i = 0; i < 5; ++i) {
