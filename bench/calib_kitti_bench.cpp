@@ -18,6 +18,7 @@
 
 #include "fusedet/fusion/calib_kitti.h"
 #include "fusedet/fusion/calib_targetless.h"
+#include "fusedet/fusion/score_profile.h"
 
 namespace {
 
@@ -72,7 +73,11 @@ int main(int argc, char** argv) {
   app.add_option("--levels", levels, "pyramid levels")->capture_default_str();
   app.add_option("--max-rotation-deg", failDeg, "exit 1 if a measure's median rotation error is larger")->capture_default_str();
   app.add_option("--max-translation", failT, "exit 1 if a measure's median translation error [m] is larger")->capture_default_str();
-  bool profile = false;
+  bool profile = false, occlusion = true, between = true;
+  app.add_flag("!--edge-at-sample", between, "depth edges at the foreground sample, not half way to the background one");
+  double decay = TargetlessOptions{}.edgeDecay;
+  app.add_option("--edge-decay", decay, "max-decay spread of image edges per pixel")->capture_default_str();
+  app.add_flag("!--keep-occluded", occlusion, "keep points hidden behind nearer ones in the camera view");
   app.add_flag("--profile", profile, "print the scores along each axis around the calib, then exit");
   CLI11_PARSE(app, argc, argv);
 
@@ -83,26 +88,21 @@ int main(int argc, char** argv) {
   std::printf("\nstarts: calib perturbed by %.2f..%.2f deg and %.3f..%.3f m, seed %u; one thread\n",
               fraction * maxDeg, maxDeg, fraction * maxT, maxT, seed);
 
+  TargetlessOptions base;
+  base.edgeDecay = decay;
+  base.removeOccluded = occlusion;
+  base.edgeBetweenSamples = between;
   if (profile) {
-    // Scores when the calib is moved along one camera axis: the peak should sit at 0.
-    const double offsets[] = {-3.0, -2.0, -1.0, -0.5, -0.25, -0.1, 0.0, 0.1, 0.25, 0.5, 1.0, 2.0, 3.0};
-    constexpr std::size_t kOffsets = std::size(offsets);
-    std::vector<Eigen::Isometry3d> candidates;
-    for (int axis = 0; axis < 6; ++axis)
-      for (double o : offsets) {
-        Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
-        if (axis < 3)
-          d.linear() = Eigen::AngleAxisd(o * M_PI / 180.0, Eigen::Vector3d::Unit(axis)).toRotationMatrix();
-        else
-          d.translation() = 0.1 * o * Eigen::Vector3d::Unit(axis - 3);
-        candidates.push_back(d * in.laserToCamera);
-      }
-    const auto scores = scoreAlignments(in.frames, in.K, in.laserToCamera, candidates);
-    std::printf("axis      offset        mi     edges  points   (rotation offsets in deg, translation in dm)\n");
-    const char* names[] = {"rot_x", "rot_y", "rot_z", "t_x", "t_y", "t_z"};
-    for (std::size_t i = 0; i < scores.size(); ++i)
-      std::printf("%-6s %9.2f  %8.5f  %8.5f  %6zu\n", names[i / kOffsets], offsets[i % kOffsets], scores[i].mutualInformation,
-                  scores[i].edgeAlignment, scores[i].points);
+    std::fputs(formatScoreProfile(scoreProfile(in.frames, in.K, in.laserToCamera, 20, 0.05, 0.005, base)).c_str(), stdout);
+    // Each frame alone: where its own profiles peak shows whether the frames agree.
+    std::printf("\neach frame alone: peaks (rot_x rot_y rot_z [deg], t_x t_y t_z [cm]), edges | mi\n");
+    for (const CalibFrame& f : in.frames) {
+      const std::string table = formatScoreProfile(scoreProfile({f}, in.K, in.laserToCamera, 20, 0.05, 0.005, base));
+      std::printf("%-28s", f.name.c_str());
+      for (std::size_t at = table.find("peak at"); at != std::string::npos; at = table.find("peak at", at + 1))
+        std::printf(" %s |", table.substr(at + 7, table.find('\n', at) - at - 7).c_str());
+      std::printf("\n");
+    }
     return 0;
   }
   std::mt19937 rng(seed);
@@ -111,7 +111,7 @@ int main(int argc, char** argv) {
 
   bool pass = true;
   for (const std::string& name : measures) {
-    TargetlessOptions opt;
+    TargetlessOptions opt = base;
     opt.measure = parseAlignmentMeasure(name);
     opt.pyramidLevels = levels;
     opt.estimateUncertainty = false;  // the trials measure the error itself

@@ -9,11 +9,13 @@
 #include <sstream>
 
 #include "command.h"
+#include "fusedet/daemon/calib_log.h"
 #include "fusedet/fusion/calib_kitti.h"
 #include "fusedet/fusion/calib_overlay.h"
 #include "fusedet/fusion/calib_targetless.h"
 #include "fusedet/fusion/camera_model.h"
 #include "fusedet/fusion/extrinsics_file.h"
+#include "fusedet/fusion/score_profile.h"
 
 namespace fusedet::tools {
 namespace {
@@ -22,13 +24,16 @@ namespace fs = std::filesystem;
 
 struct CalibrateOptions {
   std::vector<fs::path> kitti;
+  fs::path log;
   fs::path init;
   fs::path out;
   fs::path overlayDir;
   int frames = 10;
   std::string measure = "edges";
   int levels = 1;
+  double edgeDecay = fusion::TargetlessOptions{}.edgeDecay;
   bool uncertainty = true;
+  bool profile = false;
 };
 
 std::string describe(const Eigen::Isometry3d& T) {
@@ -47,32 +52,69 @@ std::string scoreLine(const fusion::AlignmentScore& s) {
   return buf;
 }
 
-int runCalibrate(const CalibrateOptions& o) {
-  if (o.kitti.empty()) throw std::runtime_error("give --kitti DIR (one or more KITTI-layout directories)");
-  const fusion::KittiCalibrationInput in = fusion::loadKittiCalibrationInput(o.kitti, static_cast<std::size_t>(o.frames));
-  const Eigen::Isometry3d init = o.init.empty() ? in.laserToCamera : fusion::readLaserToCamera(o.init);
-  std::printf("frames    %zu of %zu of one rig (%zu frames of other rigs skipped):", in.frames.size(), in.rigFrames,
-              in.otherRigFrames);
+// The frames, their pinhole and the rig's own transform, from KITTI directories or a sensor log.
+struct Input {
+  std::vector<fusion::CalibFrame> frames;
+  Eigen::Matrix3d K;
+  Eigen::Isometry3d rig;      // the calib files' Tr_velo_to_cam, or the log's fusion.laser_to_camera
+  std::string rigName;
+  std::string projection;     // what the result maps into, for the output's comment
+};
+
+Input loadInput(const CalibrateOptions& o) {
+  if (o.kitti.empty() == o.log.empty()) throw std::runtime_error("give either --kitti DIR (one or more) or --log LOG");
+  Input in;
+  if (!o.log.empty()) {
+    daemon::LogCalibrationInput l = daemon::loadLogCalibrationInput(o.log, static_cast<std::size_t>(o.frames));
+    std::printf("frames    %zu of %zu sweeps paired with a camera frame (%zu sweeps in the log):", l.frames.size(), l.paired,
+                l.sweeps);
+    in.frames = std::move(l.frames);
+    in.K = l.K;
+    in.rig = l.laserToCamera;
+    in.rigName = "the log's fusion.laser_to_camera";
+    in.projection = "maps the log's laser base frame into its camera (undistorted with the log's camera.yaml)";
+  } else {
+    fusion::KittiCalibrationInput k = fusion::loadKittiCalibrationInput(o.kitti, static_cast<std::size_t>(o.frames));
+    std::printf("frames    %zu of %zu of one rig (%zu frames of other rigs skipped):", k.frames.size(), k.rigFrames,
+                k.otherRigFrames);
+    in.frames = std::move(k.frames);
+    in.K = k.K;
+    in.rig = k.laserToCamera;
+    in.rigName = "the calib files' Tr_velo_to_cam";
+    in.projection = "maps Velodyne points into the rectified colour camera of the calib files (K = P2's left 3x3)";
+  }
   for (const fusion::CalibFrame& f : in.frames) std::printf(" %s", f.name.c_str());
-  std::printf("\nstart     %s (%s)\n", describe(init).c_str(), o.init.empty() ? "the calib files" : o.init.c_str());
+  std::printf("\n");
+  return in;
+}
+
+int runCalibrate(const CalibrateOptions& o) {
+  const Input in = loadInput(o);
+  if (!o.profile && o.out.empty()) throw std::runtime_error("give --out FILE (or --profile)");
+  const Eigen::Isometry3d init = o.init.empty() ? in.rig : fusion::readLaserToCamera(o.init);
+  std::printf("start     %s (%s)\n", describe(init).c_str(), o.init.empty() ? in.rigName.c_str() : o.init.c_str());
 
   fusion::TargetlessOptions opt;
   opt.measure = fusion::parseAlignmentMeasure(o.measure);
   opt.pyramidLevels = o.levels;
   opt.estimateUncertainty = o.uncertainty;
+  opt.edgeDecay = o.edgeDecay;
+  if (o.profile) {
+    std::fputs(fusion::formatScoreProfile(fusion::scoreProfile(in.frames, in.K, init, 20, 0.05, 0.005, opt)).c_str(), stdout);
+    return 0;
+  }
   const fusion::TargetlessResult r = fusion::calibrateTargetless(in.frames, in.K, init, opt);
 
   const double dRot = fusion::rotationErrorDeg(r.laserToCamera, init), dT = fusion::translationError(r.laserToCamera, init);
   std::printf("result    %s\n", describe(r.laserToCamera).c_str());
   std::printf("change    %.4f deg, %.4f m from the start\n", dRot, dT);
-  std::printf("calib     %.4f deg, %.4f m from the calib files' Tr_velo_to_cam\n",
-              fusion::rotationErrorDeg(r.laserToCamera, in.laserToCamera),
-              fusion::translationError(r.laserToCamera, in.laserToCamera));
+  std::printf("rig       %.4f deg, %.4f m from %s\n", fusion::rotationErrorDeg(r.laserToCamera, in.rig),
+              fusion::translationError(r.laserToCamera, in.rig), in.rigName.c_str());
   std::printf("before    %s\nafter     %s\n", scoreLine(r.before).c_str(), scoreLine(r.after).c_str());
   std::ostringstream comment;
   comment << "fusedet calibrate (targetless, measure " << o.measure << ") from " << in.frames.size() << " frames:";
   for (const fusion::CalibFrame& f : in.frames) comment << " " << f.name;
-  comment << "\nmaps Velodyne points into the rectified colour camera of the calib files (K = P2's left 3x3)";
+  comment << "\n" << in.projection;
   comment << "\nbefore: " << scoreLine(r.before) << "\nafter:  " << scoreLine(r.after);
   if (std::isfinite(r.rotationStdDeg.x())) {
     char buf[200];
@@ -119,20 +161,38 @@ const bool registered = registerCommand(
           "With --kitti, frames are read from KITTI-layout directories (image_2/, velodyne/, calib/);\n"
           "only frames of the rig with the most frames (identical calib files) are used, spread evenly.\n"
           "The result maps Velodyne points into the rectified colour camera (K = P2's left 3x3).\n\n"
+          "With --log, a sensor log (docs/log-format.md, from fusedet record or fusedet synth-log) is\n"
+          "replayed with the rig it carries: scans and tilt samples become sweeps, each paired with the\n"
+          "camera frame nearest its middle, as in fusedetd; --frames pairs spread over the whole log are\n"
+          "used, images undistorted with the log's camera.yaml. The start is the log's\n"
+          "fusion.laser_to_camera unless --init names another; the result maps the laser base frame into\n"
+          "the camera, the block fusedetd reads.\n\n"
+          "The measure: depth-edge points (nearer than a neighbour by >= 0.3 m, weighted by the jump)\n"
+          "should land on image edges (Sobel, spread by a max-decay filter, --edge-decay per pixel),\n"
+          "beyond what other points find there. Points hidden behind nearer ones in the camera's view are\n"
+          "dropped first (the laser sits elsewhere than the camera, so its background shows through\n"
+          "foreground silhouettes).\n\n"
           "Writes --out as a config fragment (fusion.laser_to_camera: rotation_rpy_deg, translation) that\n"
           "fusedetd reads unchanged, with the scores and a 1-sigma uncertainty (leave-one-frame-out\n"
           "jackknife) as comments. --overlay-dir gets one PNG per frame: laser points (near red, far\n"
           "blue) on the image, before (top) and after (bottom), to judge the result by eye.\n\n"
-          "Example:\n"
+          "Examples:\n"
           "  fusedet calibrate --kitti ../shared/data/kitti --kitti ../shared/data/kitti_0009 \\\n"
-          "      --out extrinsics.yaml --overlay-dir /tmp/calib-overlays");
-      app.add_option("--kitti", o->kitti, "KITTI-layout directory with image_2/, velodyne/, calib/ (repeatable)")
-          ->required()
-          ->check(CLI::ExistingDirectory);
+          "      --out extrinsics.yaml --overlay-dir /tmp/calib-overlays\n"
+          "  fusedet calibrate --log run.mcap --init extrinsics.yaml --out refined.yaml");
+      auto* kitti = app.add_option("--kitti", o->kitti, "KITTI-layout directory with image_2/, velodyne/, calib/ (repeatable)")
+                        ->check(CLI::ExistingDirectory);
+      app.add_option("--log", o->log, "sensor log (MCAP) with its rig metadata, from fusedet record or synth-log")
+          ->check(CLI::ExistingFile)
+          ->excludes(kitti);
       app.add_option("--init", o->init,
                      "start from this YAML's fusion.laser_to_camera (a config or a previous --out) instead of the calib files")
           ->check(CLI::ExistingFile);
-      app.add_option("--out", o->out, "YAML file to write the fusion.laser_to_camera block to")->required();
+      auto* out = app.add_option("--out", o->out, "YAML file to write the fusion.laser_to_camera block to");
+      app.add_flag("--profile", o->profile,
+                   "diagnose instead: print both measures along each axis around the start (+-1 deg in 0.05 deg, "
+                   "+-10 cm in 5 mm steps) and each axis' peak; a right start peaks at 0, a flat axis is unobserved")
+          ->excludes(out);
       app.add_option("--overlay-dir", o->overlayDir, "directory for the before/after overlay PNGs (created; none if unset)");
       app.add_option("--frames", o->frames, "frames to use, spread over the directories")
           ->capture_default_str()
@@ -140,6 +200,9 @@ const bool registered = registerCommand(
       app.add_option("--measure", o->measure, "agreement to maximise: mi (remission vs intensity), edges, both")
           ->capture_default_str()
           ->check(CLI::IsMember({"mi", "edges", "both"}));
+      app.add_option("--edge-decay", o->edgeDecay, "spread of image edges: kept fraction per pixel of distance, (0, 1)")
+          ->capture_default_str()
+          ->check(CLI::Range(0.05, 0.99));
       app.add_option("--levels", o->levels, "image pyramid levels, coarse to fine")->capture_default_str()->check(CLI::Range(1, 5));
       app.add_flag("!--no-uncertainty", o->uncertainty, "skip the jackknife (about 1.5x faster)");
       return [o] { return runCalibrate(*o); };

@@ -11,22 +11,31 @@ namespace {
 
 constexpr float kMinEdgeJump = 0.3f;       // [m] range step that makes a depth edge
 constexpr float kMaxEdgeJump = 10.0f;      // [m] larger steps weigh no more
-constexpr float kEdgeDecay = 0.95f;        // max-decay filter, per pixel of the level
 constexpr float kEdgeSelf = 1.0f / 3.0f;   // weight of the undecayed edge strength (Levinson & Thrun)
 constexpr double kImageMargin = 0.15;      // points this far (fraction of the size) outside count
 
 // Range jump from each point to its farthest neighbour on a spherical grid (azimuth x elevation
 // cells, the nearest point of a cell stands for it): left, right, above and below, each the first
-// occupied cell within kGridReach. A point in front of a farther surface is a depth edge. The grid
+// occupied cell within reach. A point in front of a farther surface is a depth edge. The grid
 // makes no assumption about the scanner's beam order or line pattern.
 constexpr double kAzimuthCellDeg = 0.2;
 constexpr double kElevationCellDeg = 0.3;
-constexpr int kGridReach = 2;
+// Reach in cells: 0.4 deg in azimuth, 0.6 deg in elevation (the Velodyne's rings are ~0.4 deg
+// apart). A tilting LMS 291 at 1 deg resolution thus gives depth edges across its scan lines
+// only: reaching across its 1 deg gaps made the profiles on synthesised logs worse (peaks
+// 0.25 deg / 3.5 cm off instead of 0.05 deg / 0.5 cm about and along the camera's y axis).
+constexpr int kAzimuthReach = 2;
+constexpr int kElevationReach = 2;
 constexpr float kStepRatio = 3.f;
 
-std::vector<float> depthJumps(const Sweep& sweep) {
+struct DepthJump {
+  float jump = 0;              // [m] 0 = no depth edge
+  std::int32_t farther = -1;   // the neighbour behind the edge
+};
+
+std::vector<DepthJump> depthJumps(const Sweep& sweep) {
   const std::size_t n = sweep.points.size();
-  std::vector<float> jump(n, 0.f);
+  std::vector<DepthJump> jump(n);
   if (n == 0) return jump;
   constexpr double kRad = 180.0 / M_PI;
   std::vector<float> range(n);
@@ -52,30 +61,33 @@ std::vector<float> depthJumps(const Sweep& sweep) {
     std::int32_t& c = at(row[i], col[i]);
     if (c < 0 || range[i] < range[static_cast<std::size_t>(c)]) c = static_cast<std::int32_t>(i);
   }
-  // Range of the first occupied cell within kGridReach in direction (dr, dc); NaN if none.
-  auto neighbourRange = [&](std::size_t i, int dr, int dc) {
-    for (int k = 1; k <= kGridReach; ++k) {
+  // The first occupied cell within reach in direction (dr, dc); -1 if none.
+  auto neighbour = [&](std::size_t i, int dr, int dc) -> std::int32_t {
+    const int reach = dr != 0 ? kElevationReach : kAzimuthReach;
+    for (int k = 1; k <= reach; ++k) {
       const int r = row[i] + dr * k;
       if (r < rowMin || r > rowMax) break;
       const std::int32_t other = at(r, (col[i] + dc * k + cols) % cols);  // azimuth wraps around
-      if (other >= 0) return range[static_cast<std::size_t>(other)];
+      if (other >= 0) return other;
     }
-    return std::numeric_limits<float>::quiet_NaN();
+    return -1;
+  };
+  auto rangeOf = [&](std::int32_t k) {
+    return k < 0 ? std::numeric_limits<float>::quiet_NaN() : range[static_cast<std::size_t>(k)];
   };
   const int dirs[4][2] = {{0, 1}, {0, -1}, {1, 0}, {-1, 0}};
   for (std::size_t i = 0; i < n; ++i) {
     if (at(row[i], col[i]) != static_cast<std::int32_t>(i)) continue;
-    float j = 0;
     for (const auto& d : dirs) {
-      const float ahead = neighbourRange(i, d[0], d[1]) - range[i];
+      const std::int32_t next = neighbour(i, d[0], d[1]);
+      const float ahead = rangeOf(next) - range[i];
       if (!(ahead > 0)) continue;
       // A step, not a slope: ground and walls seen at a grazing angle grow in range steadily
       // from ring to ring, so the range must rise much more ahead than it fell behind.
-      const float behind = range[i] - neighbourRange(i, -d[0], -d[1]);
+      const float behind = range[i] - rangeOf(neighbour(i, -d[0], -d[1]));
       if (behind > 0 && ahead < kStepRatio * behind) continue;
-      j = std::max(j, ahead);
+      if (ahead > jump[i].jump) jump[i] = {ahead, next};
     }
-    jump[i] = j;
   }
   return jump;
 }
@@ -114,7 +126,7 @@ void maxDecay(cv::Mat& d, float decay) {
 }
 
 // Gradient magnitude scaled so that its 99th percentile is 1, clipped at 1, then spread.
-cv::Mat edgeMap(const cv::Mat& intensity) {
+cv::Mat edgeMap(const cv::Mat& intensity, float decay) {
   cv::Mat gx, gy, mag;
   cv::Sobel(intensity, gx, CV_32F, 1, 0, 3);
   cv::Sobel(intensity, gy, CV_32F, 0, 1, 3);
@@ -125,7 +137,7 @@ cv::Mat edgeMap(const cv::Mat& intensity) {
   const float scale = *k > 0 ? 1.f / *k : 1.f;
   cv::Mat e = cv::min(mag * scale, 1.0);
   cv::Mat spread = e.clone();
-  maxDecay(spread, kEdgeDecay);
+  maxDecay(spread, decay);
   return kEdgeSelf * e + (1 - kEdgeSelf) * spread;
 }
 
@@ -141,6 +153,47 @@ inline bool sample(const cv::Mat& img, float u, float v, float& out) {
   return true;
 }
 
+// Where the silhouette most likely is: the foreground sample lies inside the object by up to one
+// sample spacing, the background sample beyond it; the edge is taken half way between their
+// directions, at the foreground's range (else every depth edge sits half a spacing inside its
+// object, a bias of ~0.2 deg at the Velodyne's ring spacing, more for sparser scanners).
+Eigen::Vector3f silhouettePoint(const SweepPoint& near, const SweepPoint& far) {
+  const Eigen::Vector3f a(near.x, near.y, near.z), b(far.x, far.y, far.z);
+  return a.norm() * (a.normalized() + b.normalized()).normalized();
+}
+
+// Marks points hidden in the camera's view: a nearer point (by more than kOcclusionGap or 10 %)
+// projects within kOcclusionFootprintDeg of it. The camera sees from elsewhere than the laser, so
+// the laser's background shows through foreground silhouettes, where its image values belong to
+// the foreground.
+constexpr double kOcclusionFootprintDeg = 0.25;
+constexpr float kOcclusionGap = 0.3f;  // [m]
+
+std::vector<bool> occludedInCamera(const std::vector<Eigen::Vector3d>& camera, const Eigen::Matrix3d& K, int width,
+                                   int height) {
+  const int margin = static_cast<int>(kImageMargin * std::max(width, height)) + 1;
+  const int bw = width + 2 * margin, bh = height + 2 * margin;
+  const int half = std::max(1, static_cast<int>(std::lround(K(0, 0) * kOcclusionFootprintDeg * M_PI / 180.0)));
+  cv::Mat nearest(bh, bw, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  std::vector<cv::Point> px(camera.size());
+  for (std::size_t i = 0; i < camera.size(); ++i) {
+    const Eigen::Vector3d p = K * camera[i] / camera[i].z();
+    px[i] = {std::clamp(static_cast<int>(std::lround(p.x())) + margin, 0, bw - 1),
+             std::clamp(static_cast<int>(std::lround(p.y())) + margin, 0, bh - 1)};
+    const float d = static_cast<float>(camera[i].z());
+    for (int y = std::max(0, px[i].y - half); y <= std::min(bh - 1, px[i].y + half); ++y) {
+      float* row = nearest.ptr<float>(y);
+      for (int x = std::max(0, px[i].x - half); x <= std::min(bw - 1, px[i].x + half); ++x) row[x] = std::min(row[x], d);
+    }
+  }
+  std::vector<bool> hidden(camera.size());
+  for (std::size_t i = 0; i < camera.size(); ++i) {
+    const float d = static_cast<float>(camera[i].z());
+    hidden[i] = nearest.at<float>(px[i]) < d - std::max(kOcclusionGap, 0.1f * d);
+  }
+  return hidden;
+}
+
 }  // namespace
 
 std::vector<LaserSamples> prepareLaserSamples(const std::vector<CalibFrame>& frames, const Eigen::Matrix3d& K,
@@ -151,7 +204,9 @@ std::vector<LaserSamples> prepareLaserSamples(const std::vector<CalibFrame>& fra
   for (std::size_t f = 0; f < frames.size(); ++f) {
     const CalibFrame& frame = frames[f];
     const double w = frame.image.cols, h = frame.image.rows;
-    const std::vector<float> jump = depthJumps(frame.sweep);
+    const std::vector<DepthJump> jump = depthJumps(frame.sweep);
+    std::vector<std::size_t> chosen;
+    std::vector<Eigen::Vector3d> camera;
     for (std::size_t i = 0; i < frame.sweep.points.size(); ++i) {
       const SweepPoint& p = frame.sweep.points[i];
       const Eigen::Vector3d c = reference * Eigen::Vector3d(p.x, p.y, p.z);
@@ -160,12 +215,21 @@ std::vector<LaserSamples> prepareLaserSamples(const std::vector<CalibFrame>& fra
       if (px.x() < -kImageMargin * w || px.x() > (1 + kImageMargin) * w || px.y() < -kImageMargin * h ||
           px.y() > (1 + kImageMargin) * h)
         continue;
+      chosen.push_back(i);
+      camera.push_back(c);
+    }
+    const std::vector<bool> hidden = options.removeOccluded ? occludedInCamera(camera, K, frame.image.cols, frame.image.rows)
+                                                            : std::vector<bool>(camera.size(), false);
+    for (std::size_t k = 0; k < chosen.size(); ++k) {
+      if (hidden[k]) continue;
+      const std::size_t i = chosen[k];
+      const SweepPoint& p = frame.sweep.points[i];
       const Eigen::Vector3f xyz(p.x, p.y, p.z);
       out[f].xyz.push_back(xyz);
       remissions[f].push_back(std::clamp(p.remission, 0.f, 1.f));
-      if (jump[i] >= kMinEdgeJump) {
-        out[f].edgeXyz.push_back(xyz);
-        out[f].edgeWeight.push_back(std::sqrt(std::min(jump[i], kMaxEdgeJump)));
+      if (jump[i].jump >= kMinEdgeJump) {
+        out[f].edgeXyz.push_back(options.edgeBetweenSamples ? silhouettePoint(p, frame.sweep.points[static_cast<std::size_t>(jump[i].farther)]) : xyz);
+        out[f].edgeWeight.push_back(std::sqrt(std::min(jump[i].jump, kMaxEdgeJump)));
         out[f].edgeWeightSum += out[f].edgeWeight.back();
       } else if (out[f].xyz.size() % kPlainStride == 0) {
         out[f].plainXyz.push_back(xyz);
@@ -185,7 +249,7 @@ std::vector<LaserSamples> prepareLaserSamples(const std::vector<CalibFrame>& fra
   return out;
 }
 
-std::vector<LevelImage> prepareLevelImages(const cv::Mat& image, int levels) {
+std::vector<LevelImage> prepareLevelImages(const cv::Mat& image, int levels, double edgeDecay) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3))
     throw std::invalid_argument("targetless calibration: images must be 8-bit grey or BGR");
   cv::Mat grey;
@@ -198,7 +262,7 @@ std::vector<LevelImage> prepareLevelImages(const cv::Mat& image, int levels) {
   std::vector<LevelImage> out(static_cast<std::size_t>(levels));
   equalised.convertTo(out[0].intensity, CV_32F, kIntensityBins / 256.0);
   for (std::size_t l = 1; l < out.size(); ++l) cv::pyrDown(out[l - 1].intensity, out[l].intensity);
-  for (LevelImage& li : out) li.edges = edgeMap(li.intensity);
+  for (LevelImage& li : out) li.edges = edgeMap(li.intensity, static_cast<float>(edgeDecay));
   return out;
 }
 

@@ -36,8 +36,9 @@ inline constexpr int kPlainStride = 4;
 std::vector<LaserSamples> prepareLaserSamples(const std::vector<CalibFrame>& frames, const Eigen::Matrix3d& K,
                                               const Eigen::Isometry3d& reference, const TargetlessOptions& options);
 
-// The image pyramid of one frame: level l has 1/2^l resolution.
-std::vector<LevelImage> prepareLevelImages(const cv::Mat& image, int levels);
+// The image pyramid of one frame: level l has 1/2^l resolution; edges spread by edgeDecay per
+// pixel of the level.
+std::vector<LevelImage> prepareLevelImages(const cv::Mat& image, int levels, double edgeDecay);
 
 class AlignmentCost {
  public:

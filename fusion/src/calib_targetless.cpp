@@ -110,10 +110,10 @@ void checkFrames(const std::vector<CalibFrame>& frames, const TargetlessOptions&
                                   std::to_string(options.pyramidLevels) + " pyramid levels");
 }
 
-std::vector<std::vector<detail::LevelImage>> pyramids(const std::vector<CalibFrame>& frames, int levels) {
+std::vector<std::vector<detail::LevelImage>> pyramids(const std::vector<CalibFrame>& frames, int levels, double edgeDecay) {
   std::vector<std::vector<detail::LevelImage>> out;
   out.reserve(frames.size());
-  for (const CalibFrame& f : frames) out.push_back(detail::prepareLevelImages(f.image, levels));
+  for (const CalibFrame& f : frames) out.push_back(detail::prepareLevelImages(f.image, levels, edgeDecay));
   return out;
 }
 
@@ -125,7 +125,7 @@ std::vector<AlignmentScore> scoreAlignments(const std::vector<CalibFrame>& frame
                                             const TargetlessOptions& options) {
   checkFrames(frames, options);
   const auto laser = detail::prepareLaserSamples(frames, K, reference, options);
-  const auto images = pyramids(frames, 1);
+  const auto images = pyramids(frames, 1, options.edgeDecay);
   const detail::AlignmentCost cost(laser, images, K, 0);
   std::vector<AlignmentScore> out;
   for (const Eigen::Isometry3d& T : candidates) out.push_back(cost.score(T));
@@ -136,7 +136,7 @@ TargetlessResult calibrateTargetless(const std::vector<CalibFrame>& frames, cons
                                      const Eigen::Isometry3d& init, const TargetlessOptions& options) {
   checkFrames(frames, options);
   const auto laser = detail::prepareLaserSamples(frames, K, init, options);
-  const auto images = pyramids(frames, options.pyramidLevels);
+  const auto images = pyramids(frames, options.pyramidLevels, options.edgeDecay);
   TargetlessResult result;
   Eigen::Isometry3d current = init;
   auto outside = [&](const Eigen::Isometry3d& T) {

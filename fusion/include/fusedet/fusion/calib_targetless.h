@@ -44,6 +44,13 @@ struct TargetlessOptions {
   double maxTranslation = 0.4;     // [m]
   double minDepth = 1.0;           // [m] points nearer the camera plane are not used
   double maxRange = 80.0;          // [m]
+  // Points hidden in the camera's view behind nearer points (the laser sits elsewhere, so its
+  // background leaks through foreground silhouettes) are dropped, judged under the start.
+  bool removeOccluded = true;
+  // Depth edges placed half way between the foreground sample and the background one behind it
+  // (false: at the foreground sample, inside the object).
+  bool edgeBetweenSamples = true;
+  double edgeDecay = 0.8;          // max-decay spread of image edges per pixel of full resolution
   bool estimateUncertainty = true; // leave-one-frame-out jackknife at full resolution (>= 3 frames)
 };
 
