@@ -2,6 +2,7 @@
 // (docs/protocol.md). Arguments only; the service lives in daemon/ (run.h).
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 #include "fusedet/daemon/config.h"
@@ -10,7 +11,9 @@
 int main(int argc, char** argv) {
   CLI::App app{"fusedetd - fusedet perception service (camera + tilting laser -> detections)", "fusedetd"};
   fusedet::daemon::RunOptions options;
-  options.configFile = FUSEDET_DEFAULT_CONFIG;
+  std::error_code ec;
+  const auto self = std::filesystem::canonical("/proc/self/exe", ec);
+  options.configFile = fusedet::daemon::installedConfigFile(ec ? std::filesystem::path("/usr/bin/fusedetd") : self);
   bool checkOnly = false;
   app.add_option("-c,--config", options.configFile, "YAML configuration file")->capture_default_str();
   app.add_option("-s,--socket", options.socketPath,

@@ -211,6 +211,12 @@ Config loadConfig(const std::filesystem::path& file) {
   return parseConfig(text.str(), file.string());
 }
 
+std::filesystem::path installedConfigFile(const std::filesystem::path& executable) {
+  const std::filesystem::path prefix = executable.parent_path().parent_path();
+  const std::filesystem::path etc = prefix == "/usr" ? std::filesystem::path("/etc") : prefix / "etc";
+  return etc / "fusedet" / "fusedet.yaml";
+}
+
 std::string dumpConfig(const Config& c) {
   YAML::Emitter out;
   auto seq = [&out](const auto& values) {

@@ -96,3 +96,9 @@ TEST(Config, DemoFileLoadsAndNamesTheBundledModels) {
 TEST(Config, MissingFile) {
   EXPECT_THROW((void)loadConfig("/nonexistent/fusedet.yaml"), ConfigError);
 }
+
+TEST(Config, InstalledConfigFileFollowsThePrefixAndTheFhsRuleForUsr) {
+  EXPECT_EQ(installedConfigFile("/usr/bin/fusedetd"), "/etc/fusedet/fusedet.yaml");
+  EXPECT_EQ(installedConfigFile("/usr/local/bin/fusedetd"), "/usr/local/etc/fusedet/fusedet.yaml");
+  EXPECT_EQ(installedConfigFile("/opt/robot/bin/fusedetd"), "/opt/robot/etc/fusedet/fusedet.yaml");
+}

@@ -100,4 +100,10 @@ Config parseConfig(const std::string& yamlText, const std::string& sourceName);
 // The effective configuration as YAML, every key present (for --check-config and status).
 std::string dumpConfig(const Config& config);
 
+// The config file of the installation `executable` belongs to (the default of fusedetd --config):
+// <prefix>/etc/fusedet/fusedet.yaml, where <prefix> is the folder above the executable's bin/, and
+// /etc/fusedet/fusedet.yaml for the prefix /usr (the FHS rule GNUInstallDirs applies, taken at run
+// time so that one build serves `cmake --install --prefix P` and the /usr Debian package alike).
+std::filesystem::path installedConfigFile(const std::filesystem::path& executable);
+
 }  // namespace fusedet::daemon

@@ -1,0 +1,49 @@
+# The Debian package (docs/packaging.md): `cpack -G DEB` in the build folder, or
+# `cmake --build build --target package`. It holds the install component `runtime` only, staged
+# with DESTDIR under the prefix /usr, so /etc, /lib/systemd/system and /usr/bin are the FHS places
+# whatever prefix the build was configured with (cmake/install_system_files.cmake).
+
+# Debian's changelog and copyright belong in /usr/share/doc/fusedet; the changelog gzip'ed without
+# a time stamp (reproducible, as dh_compress does).
+set(_changelog_gz ${PROJECT_BINARY_DIR}/deb/changelog.gz)
+add_custom_command(OUTPUT ${_changelog_gz}
+                   COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/deb
+                   COMMAND gzip -9n -c ${PROJECT_SOURCE_DIR}/cmake/deb/changelog > ${_changelog_gz}
+                   DEPENDS ${PROJECT_SOURCE_DIR}/cmake/deb/changelog VERBATIM)
+add_custom_target(fusedet_deb_changelog ALL DEPENDS ${_changelog_gz})
+install(FILES ${_changelog_gz} cmake/deb/copyright DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT runtime)
+
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME fusedet)
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_CONTACT "fusedet maintainers <maintainers@users.noreply.h-seed-b2ba83ed.example>")
+set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "object detection for robots from a colour camera and a tilting laser")
+# The synopsis line is CPACK_PACKAGE_DESCRIPTION_SUMMARY; this is the extended description.
+set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "fusedetd fuses a SICK LMS 291 laser scanner nodded by a CANopen tilt motor
+with a V4L2 camera into seven-layer stacks, runs one boosted cascade per
+object class on them and serves the detections (class, score, image box,
+3D position) as newline-delimited JSON on a Unix socket, as a systemd
+service with socket activation and a watchdog.
+.
+The package contains fusedetd, the fusedet command line (device checks,
+training, evaluation, query client), the lms291-sim and tilt-sim device
+simulators, the bundled car, bike and person models and the systemd units.
+The units are not enabled on installation: configure the devices in
+/etc/fusedet/fusedet.yaml first.")
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
+# Library dependencies come from dpkg-shlibdeps; the maintainer scripts need systemd-sysusers and
+# deb-systemd-helper.
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "systemd | systemd-standalone-sysusers | systemd-sysusers, init-system-helpers (>= 1.54~)")
+set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
+    ${PROJECT_SOURCE_DIR}/cmake/deb/postinst ${PROJECT_SOURCE_DIR}/cmake/deb/prerm
+    ${PROJECT_SOURCE_DIR}/cmake/deb/postrm ${PROJECT_SOURCE_DIR}/cmake/deb/conffiles)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
+set(CPACK_STRIP_FILES TRUE)
+set(CPACK_SET_DESTDIR ON)
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_INSTALL_PREFIX /usr)  # what CMAKE_INSTALL_PREFIX is while cpack installs (with DESTDIR)
+set(CPACK_INSTALL_CMAKE_PROJECTS "${PROJECT_BINARY_DIR};fusedet;runtime;/")
+include(CPack)

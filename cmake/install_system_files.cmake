@@ -1,0 +1,25 @@
+# Runs at install time (install(SCRIPT), component runtime): the files whose place or content
+# depends on the prefix given to `cmake --install --prefix P` or cpack - CMAKE_INSTALL_PREFIX here -
+# rather than the one given at configure time. For the prefix /usr the FHS places apply: the
+# configuration in /etc and (Debian 12) the units in /lib/systemd/system. file(INSTALL) honours
+# DESTDIR, which is how cpack stages the package.
+if(CMAKE_INSTALL_PREFIX STREQUAL "/usr")
+  set(_etc /etc)
+  set(_units /lib/systemd/system)
+else()
+  set(_etc ${CMAKE_INSTALL_PREFIX}/etc)
+  set(_units ${CMAKE_INSTALL_PREFIX}/lib/systemd/system)
+endif()
+
+# The unit template's variables, for this prefix (ExecStart, --config, Documentation=).
+set(CMAKE_INSTALL_FULL_BINDIR ${CMAKE_INSTALL_PREFIX}/${FUSEDET_BINDIR})
+set(CMAKE_INSTALL_FULL_SYSCONFDIR ${_etc})
+set(CMAKE_INSTALL_FULL_DOCDIR ${CMAKE_INSTALL_PREFIX}/${FUSEDET_DOCDIR})
+set(_service ${FUSEDET_BINARY_DIR}/systemd/installed/fusedetd.service)
+configure_file(${FUSEDET_SOURCE_DIR}/systemd/fusedetd.service.in ${_service} @ONLY)
+
+file(INSTALL DESTINATION ${_etc}/fusedet TYPE FILE FILES ${FUSEDET_SOURCE_DIR}/config/fusedet.yaml)
+file(INSTALL DESTINATION ${_units} TYPE FILE FILES ${_service} ${FUSEDET_SOURCE_DIR}/systemd/fusedetd.socket)
+# The group of socket clients; systemd-sysusers creates it (the package's postinst runs it).
+file(INSTALL DESTINATION ${CMAKE_INSTALL_PREFIX}/lib/sysusers.d TYPE FILE
+     FILES ${FUSEDET_SOURCE_DIR}/systemd/fusedet.sysusers RENAME fusedet.conf)

@@ -1,0 +1,69 @@
+#!/usr/bin/env bash
+# The Debian package as cpack builds it from this build tree (docs/packaging.md): the files a
+# robot needs in their FHS places and nothing of the development tree, /etc/fusedet/fusedet.yaml
+# as the one conffile, dependencies computed by dpkg-shlibdeps, Debian-style maintainer scripts,
+# units that point at /usr/bin and /etc, a packaged config the packaged fusedetd accepts, and
+# lintian without errors.
+# Usage: check_package.sh BUILD_DIR SOURCE_DIR
+set -euo pipefail
+build=$1 src=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "check_package: $*" >&2; exit 1; }
+
+(cd "$build" && cpack -G DEB -B "$tmp" >"$tmp/cpack.log" 2>&1) || { cat "$tmp/cpack.log" >&2; fail "cpack failed"; }
+debs=("$tmp"/fusedet_*.deb)
+[[ ${#debs[@]} -eq 1 && -f ${debs[0]} ]] || fail "expected one fusedet_*.deb, got: ${debs[*]}"
+deb=${debs[0]}
+echo "package: $(basename "$deb") ($(stat -c %s "$deb") bytes)"
+
+# Files: everything a robot needs, at the FHS places.
+contents=$(dpkg-deb -c "$deb" | awk '{print $6}')
+for f in ./usr/bin/fusedet ./usr/bin/fusedetd ./usr/bin/lms291-sim ./usr/bin/tilt-sim \
+         ./etc/fusedet/fusedet.yaml ./lib/systemd/system/fusedetd.service ./lib/systemd/system/fusedetd.socket \
+         ./usr/lib/sysusers.d/fusedet.conf ./usr/share/fusedet/models/car.json ./usr/share/fusedet/models/bike.json \
+         ./usr/share/fusedet/models/person.json ./usr/share/doc/fusedet/copyright ./usr/share/doc/fusedet/changelog.gz \
+         ./usr/share/doc/fusedet/protocol.md; do
+  grep -qxF "$f" <<<"$contents" || fail "missing from the package: $f"
+done
+# ... and nothing from the development side or the build tree's prefix.
+if stray=$(grep -E '^\./usr/(include|local)/|\.a$|\.so$|^\./usr/etc/|^\./usr/lib/systemd/' <<<"$contents"); then
+  fail "files that do not belong in the package: $stray"
+fi
+echo "files: $(grep -vc '/$' <<<"$contents") ok"
+
+# Control: conffiles, maintainer scripts, dependencies.
+dpkg-deb -e "$deb" "$tmp/control"
+[[ $(cat "$tmp/control/conffiles") == "/etc/fusedet/fusedet.yaml" ]] || fail "conffiles: $(cat "$tmp/control/conffiles")"
+grep -q 'systemd-sysusers .*fusedet.conf' "$tmp/control/postinst" || fail "postinst does not create the group"
+grep -q 'deb-systemd-helper update-state' "$tmp/control/postinst" || fail "postinst does not record the units' state"
+if grep -v '^[[:space:]]*#' "$tmp/control/postinst" | grep -qE 'deb-systemd-invoke (start|restart)|systemctl .*(enable|start)'; then
+  fail "postinst enables or starts the service on installation"
+fi
+grep -q 'deb-systemd-helper purge' "$tmp/control/postrm" || fail "postrm does not purge the units' state"
+grep -q 'deb-systemd-invoke stop' "$tmp/control/prerm" || fail "prerm does not stop the service"
+depends=$(dpkg-deb -f "$deb" Depends)
+for d in libc6 libstdc++6 libopencv-core libsystemd0 libusb-1.0-0 libyaml-cpp 'systemd | systemd-standalone-sysusers'; do
+  grep -qF "$d" <<<"$depends" || fail "Depends lacks $d: $depends"
+done
+echo "control: conffiles, maintainer scripts and Depends ok"
+
+# Payload: units, group, config.
+dpkg-deb -x "$deb" "$tmp/root"
+grep -qx 'ExecStart=/usr/bin/fusedetd --config /etc/fusedet/fusedet.yaml' "$tmp/root/lib/systemd/system/fusedetd.service" ||
+  fail "ExecStart: $(grep ExecStart "$tmp/root/lib/systemd/system/fusedetd.service")"
+group=$(awk '$1 == "g" {print $2}' "$tmp/root/usr/lib/sysusers.d/fusedet.conf")
+grep -qx "SocketGroup=$group" "$tmp/root/lib/systemd/system/fusedetd.socket" || fail "the socket's group is not the sysusers group '$group'"
+cmp -s "$tmp/root/etc/fusedet/fusedet.yaml" "$src/config/fusedet.yaml" || fail "packaged fusedet.yaml differs from config/fusedet.yaml"
+"$tmp/root/usr/bin/fusedetd" --config "$tmp/root/etc/fusedet/fusedet.yaml" --check-config >/dev/null ||
+  fail "the packaged fusedetd rejects the packaged config"
+for m in car bike person; do
+  cmp -s "$tmp/root/usr/share/fusedet/models/$m.json" "$src/models/$m.json" || fail "model $m differs from models/$m.json"
+done
+echo "payload: units, group '$group', config and models ok"
+
+# lintian: no errors (warnings are listed in docs/packaging.md).
+lintian --tag-display-limit 0 "$deb" >"$tmp/lintian.log" 2>&1 && rc=0 || rc=$?
+grep -v 'running with root privileges' "$tmp/lintian.log" || true
+if [[ $rc -ne 0 ]] || grep -q '^E: ' "$tmp/lintian.log"; then fail "lintian reports errors (exit $rc)"; fi
+echo "lintian: $(grep -c '^E: ' "$tmp/lintian.log") errors, $(grep -c '^W: ' "$tmp/lintian.log") warnings"
