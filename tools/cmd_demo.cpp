@@ -12,6 +12,7 @@
 
 #include "command.h"
 #include "data_dir.h"
+#include "fusedet/boost/data_split.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/model_io.h"
@@ -30,12 +31,6 @@ struct DemoOptions {
   std::filesystem::path models = "models";  // one model file per class (*.json)
   int threads = 0;
 };
-
-// The frames the bundled models were not trained on: the last third of each drive, the split
-// `fusedet experiments` and `scripts/train-models` use.
-std::size_t firstTestFrame(std::size_t frames) {
-  return static_cast<std::size_t>(std::lround(static_cast<double>(frames) * 2.0 / 3.0));
-}
 
 // Detects with every model in `dir` and prints each detection with its best-matching label.
 void detectWithModels(const std::filesystem::path& dir, const LayerStack& stack, const Labels& labels,
@@ -91,7 +86,7 @@ int runDemo(const DemoOptions& o) {
     throw std::runtime_error(root.string() + ": no such data directory (set --data or FUSEDET_DATA)");
   const auto ids = fusion::listKittiFrames(root);
   if (ids.empty()) throw std::runtime_error(root.string() + ": no frames");
-  const std::string id = o.frame.empty() ? ids[std::min(firstTestFrame(ids.size()), ids.size() - 1)] : o.frame;
+  const std::string id = o.frame.empty() ? ids[std::min(boosting::firstTestFrame(ids.size()), ids.size() - 1)] : o.frame;
   const fusion::KittiFrame f = fusion::readKittiFrame(root, id);
 
   std::printf("fusedet demo: KITTI %s frame %s (%zu frames in drive)\n", o.drive.c_str(), id.c_str(),

@@ -9,15 +9,17 @@
 #include <nlohmann/json.hpp>
 
 #include "command.h"
-#include "experiments_data.h"
 #include "experiments_report.h"
-#include "experiments_run.h"
+#include "fusedet/boost/chain_evaluation.h"
+#include "fusedet/boost/class_rules.h"
+#include "fusedet/boost/data_split.h"
 #include "fusedet/boost/model_io.h"
+#include "fusedet/boost/precision_recall.h"
 
 namespace fusedet::tools {
 namespace {
 namespace fs = std::filesystem;
-using namespace experiments;
+using experiments::orderedLayers;
 using nlohmann::json;
 
 struct EvalOptions {
@@ -26,9 +28,9 @@ struct EvalOptions {
   std::string split = "test";
   double trainFraction = 2.0 / 3.0;
   bool json = false;
-  double minIou = 0.5, minHeight = 25, maxTruncation = -1;
+  double minIou = 0.5, minHeight = 25, maxTruncation = 0.3;
   int maxOcclusion = 1;
-  std::string van = "negative";
+  std::string van = "ignore";
   double scaleFactor = 1.1, step = 2;
   int minNeighbors = 3;
   int threads = 1;
@@ -62,7 +64,7 @@ int runEval(const EvalOptions& o) {
   if (o.split == "all") {
     entries = manifest;
   } else {
-    const Split s = splitByFrame(manifest, o.trainFraction);
+    const boosting::Split s = boosting::splitByFrame(manifest, o.trainFraction);
     entries = o.split == "train" ? s.train : s.test;
   }
   // Layers the models read; hue_distance is derived from hue with each model's reference hue.
@@ -75,19 +77,21 @@ int runEval(const EvalOptions& o) {
   std::vector<DatasetItem> items;
   for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(o.data, e.id, layers));
 
-  boosting::MatchConfig match = matchConfigFor(cls, parseVanPolicy(o.van));
+  boosting::MatchConfig match = boosting::matchConfigFor(cls, boosting::parseVanPolicy(o.van));
   match.minIou = o.minIou;
   match.minHeight = o.minHeight;
   match.maxOcclusion = o.maxOcclusion;
   match.maxTruncation = o.maxTruncation;
-  DetectionSetup setup;
+  boosting::DetectionSetup setup;
   setup.scan.scaleFactor = o.scaleFactor;
   setup.scan.step = o.step;
   setup.scan.threads = o.threads;
   setup.group.minNeighbors = o.minNeighbors;
   std::vector<const boosting::Detector*> chain;
   for (const auto& d : detectors) chain.push_back(&d);
-  const EvalOutcome r = evaluateChain(chain, items, match, setup);
+  const boosting::EvalOutcome r = boosting::evaluateChain(chain, items, match, setup);
+  const std::optional<double> ap = boosting::averagePrecision(boosting::allFrames(r.frames));
+  const auto orNull = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   const boosting::CascadeSummary s = summaries.size() == 1 ? summaries.front() : boosting::combineSummaries(summaries);
 
   if (o.json) {
@@ -98,9 +102,11 @@ int runEval(const EvalOptions& o) {
     j["data"] = o.data.string();
     j["split"] = o.split;
     j["stacks"] = r.counts.stacks;
-    j["recall"] = r.counts.recall();
-    j["precision"] = r.counts.precision();
-    j["f_measure"] = r.counts.fMeasure();
+    j["recall"] = orNull(r.counts.recall());
+    j["precision"] = orNull(r.counts.precision());
+    j["f_measure"] = orNull(r.counts.fMeasure());
+    j["average_precision"] = orNull(ap);
+    j["ap_rule"] = "KITTI 40 recall points";
     j["hits"] = r.counts.hits;
     j["false_alarms"] = r.counts.falseAlarms;
     j["misses"] = r.counts.misses;
@@ -114,21 +120,24 @@ int runEval(const EvalOptions& o) {
     j["ms_per_stack"] = r.msPerStack;
     j["windows"] = r.windows;
     j["match"] = {{"min_iou", match.minIou}, {"min_height", match.minHeight}, {"max_occlusion", match.maxOcclusion},
-                  {"max_truncation", match.maxTruncation}, {"van", o.van}};
+                  {"max_truncation", match.maxTruncation}, {"min_detection_height", match.minDetectionHeight},
+                  {"van", o.van}};
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   std::printf("# fusedet eval: %s\n\n", cls.c_str());
   std::printf("Model%s:", o.models.size() > 1 ? "s (AND: a window must pass each)" : "");
   for (const fs::path& m : o.models) std::printf(" `%s`", m.c_str());
-  std::printf("\n\nData: `%s`, %s split, %zu stacks. Match: IoU >= %.2f; labels lower than %.0f px or occluded "
-              "more than level %d are ignored, as are ignore regions; van: %s.\n\n",
+  std::printf("\n\nData: `%s`, %s split, %zu stacks. Match (KITTI devkit 2D rules): IoU >= %.2f; labels lower "
+              "than %.0f px, occluded more than level %d or truncated more than %.2f are ignored, as are "
+              "ignore regions and detections lower than %.0f px; van: %s.\n\n",
               o.data.c_str(), o.split.c_str(), r.counts.stacks, match.minIou, match.minHeight, match.maxOcclusion,
-              o.van.c_str());
+              match.maxTruncation, match.minDetectionHeight, o.van.c_str());
   std::printf("| measure | value |\n|---|---:|\n");
   std::printf("| length (stumps) | %zu |\n| stages | %zu |\n", s.length, s.stages);
-  std::printf("| recall | %.3f |\n| precision | %.3f |\n| F-measure | %.3f |\n", r.counts.recall(),
-              r.counts.precision(), r.counts.fMeasure());
+  std::printf("| recall | %s |\n| precision | %s |\n| F-measure | %s |\n| AP (40 recall points) | %s |\n",
+              boosting::formatMeasure(r.counts.recall(), 3).c_str(), boosting::formatMeasure(r.counts.precision(), 3).c_str(),
+              boosting::formatMeasure(r.counts.fMeasure(), 3).c_str(), boosting::formatMeasure(ap, 3).c_str());
   std::printf("| hits / false alarms / misses | %zu / %zu / %zu |\n", r.counts.hits, r.counts.falseAlarms,
               r.counts.misses);
   std::printf("| positives | %zu |\n| ignored detections | %zu |\n", r.counts.positives, r.counts.ignored);
@@ -169,10 +178,12 @@ const bool registered = registerCommand(
       app.add_option("--max-occlusion", o->maxOcclusion, "labels occluded more are ignored (KITTI moderate: 1)")
           ->capture_default_str();
       app.add_option("--max-truncation", o->maxTruncation,
-                     "labels truncated more are ignored; < 0 = not checked (KITTI tracking labels hold levels)")
+                     "labels truncated more are ignored (KITTI moderate: 0.3; tracking labels hold levels 0/1/2, so "
+                     "only level 0 passes); < 0 = not checked")
           ->capture_default_str();
-      app.add_option("--van", o->van, "a van for the car class: negative (false alarm), ignore, positive")
-          ->check(CLI::IsMember({"negative", "ignore", "positive"}))
+      app.add_option("--van", o->van, "a van for the car class: ignore (KITTI's neighbouring class: neither hit nor false alarm), "
+                     "negative (false alarm), positive")
+          ->check(CLI::IsMember({"ignore", "negative", "positive"}))
           ->capture_default_str();
       app.add_option("--scale-factor", o->scaleFactor, "window scale step")->capture_default_str();
       app.add_option("--step", o->step, "position step in base-window pixels")->capture_default_str();
@@ -182,8 +193,11 @@ const bool registered = registerCommand(
       app.footer(
           "Weight share per layer: each stump weighs |right leaf - left leaf| (how far it moves the stage "
           "sum), summed per layer over all stages and divided by the total (paper Fig. 7).\n"
-          "Ignore regions (DontCare, Truck, Tram, Misc, Person_sitting) absorb a detection lying inside them "
-          "by >= min-iou of its area.\n\n"
+          "KITTI object devkit 2D rules: DontCare regions absorb a detection lying inside them by >= min-iou "
+          "of its area; Van (for car) and Person_sitting (for person) are ignored labels; Truck, Tram and Misc "
+          "are false alarms; detections lower than 25 px are ignored. Precision without any detection is "
+          "null, not 1; AP interpolates precision at 40 recall points (KITTI since 2019) over the ranking "
+          "by score, which ends at the operating point.\n\n"
           "Examples:\n"
           "  fusedet eval -m models/car.json --data /tmp/kitti-ds\n"
           "  fusedet eval -m car_laser.json -m car_camera.json --data ds --json   # AND combination\n"

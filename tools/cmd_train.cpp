@@ -18,6 +18,9 @@
 #include "command.h"
 #include "mpi_job.h"
 #include "fusedet/boost/cascade_trainer.h"
+#include "fusedet/boost/chain_evaluation.h"
+#include "fusedet/boost/class_rules.h"
+#include "fusedet/boost/data_split.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/grouping.h"
@@ -149,8 +152,8 @@ class ConsoleProgress final : public boosting::ProgressSink {
 };
 
 // Recall / precision / F-measure of the new cascade on the held-back items, with `fusedet eval`'s
-// defaults: KITTI moderate (height >= 25 px, occlusion <= 1), IoU >= 0.5, ignore regions, other
-// classes (vans for car) are false alarms; OpenCV-style grouping.
+// defaults: the KITTI devkit's 2D rules of boost/evaluation.h (moderate, IoU >= 0.5, DontCare,
+// neighbouring classes ignored) through boost/chain_evaluation.h; OpenCV-style grouping.
 void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
                       const std::vector<std::string>& testIds) {
   if (testIds.empty()) {
@@ -158,30 +161,27 @@ void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
     return;
   }
   const boosting::Detector detector(cascade);
-  boosting::ScanParams scan;
-  scan.scaleFactor = o.evalScaleFactor;
-  scan.step = o.evalStep;
-  scan.threads = o.threads;
-  boosting::GroupParams group;
-  group.minNeighbors = o.evalMinNeighbors;
-  boosting::MatchConfig match;
-  match.className = cascade.className;
+  boosting::DetectionSetup setup;
+  setup.scan.scaleFactor = o.evalScaleFactor;
+  setup.scan.step = o.evalStep;
+  setup.scan.threads = o.threads;
+  setup.group.minNeighbors = o.evalMinNeighbors;
+  boosting::MatchConfig match = boosting::matchConfigFor(cascade.className);
   match.minHeight = o.minHeight;
   match.maxOcclusion = o.maxOcclusion;
-  boosting::Counts counts;
-  double ms = 0;
-  for (const auto& id : testIds) {
-    const DatasetItem item = readDatasetItem(o.data, id);
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto dets = boosting::detect(detector, item.stack, scan, group);
-    ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    counts.add(boosting::matchDetections(dets, item.labels, match));
-  }
+  std::vector<DatasetItem> items;
+  for (const auto& id : testIds) items.push_back(readDatasetItem(o.data, id));
+  const boosting::EvalOutcome r = boosting::evaluateChain({&detector}, items, match, setup);
+  const boosting::Counts& counts = r.counts;
+  const auto& scan = setup.scan;
+  const auto& group = setup.group;
+  const double ms = r.msPerStack * double(testIds.size());
   std::printf("eval on %zu held-back items (IoU >= %.2f, height >= %.0f px, occlusion <= %d, scale %.2f, step %.1f, "
-              "min neighbours %d): recall %.3f, precision %.3f, F-measure %.3f (hits %zu, misses %zu, false alarms "
+              "min neighbours %d): recall %s, precision %s, F-measure %s (hits %zu, misses %zu, false alarms "
               "%zu, ignored %zu); %.1f ms per stack\n",
               testIds.size(), match.minIou, match.minHeight, match.maxOcclusion, scan.scaleFactor, scan.step,
-              group.minNeighbors, counts.recall(), counts.precision(), counts.fMeasure(), counts.hits, counts.misses,
+              group.minNeighbors, boosting::formatMeasure(counts.recall(), 3).c_str(),
+              boosting::formatMeasure(counts.precision(), 3).c_str(), boosting::formatMeasure(counts.fMeasure(), 3).c_str(), counts.hits, counts.misses,
               counts.falseAlarms, counts.ignored, ms / double(testIds.size()));
   const boosting::CascadeSummary sum = boosting::summarizeCascade(cascade);
   std::printf("cascade: length %zu in %zu stages, corner features %.0f %%, weight share per layer:", sum.length,
@@ -219,31 +219,34 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validate();
   if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
 
-  // Train/test split per group, in manifest (frame) order.
-  const auto entries = readDatasetManifest(o.data);
+  // Train/test split per group, in manifest (frame) order (boost/data_split.h).
+  const auto all = readDatasetManifest(o.data);
   const std::set<std::string> groups(o.groups.begin(), o.groups.end()),
       trainOnly(o.trainOnly.begin(), o.trainOnly.end());
-  std::map<std::string, std::vector<std::string>> byGroup;
-  std::vector<std::string> order;
-  for (const auto& e : entries) {
-    if (!groups.empty() && !groups.count(e.group) && !trainOnly.count(e.group)) continue;
-    if (!byGroup.count(e.group)) order.push_back(e.group);
-    byGroup[e.group].push_back(e.id);
+  std::vector<DatasetEntry> entries;
+  std::set<std::string> present;
+  for (const auto& e : all) {
+    present.insert(e.group);
+    if (groups.empty() || groups.count(e.group) || trainOnly.count(e.group)) entries.push_back(e);
   }
   for (const auto& g : o.groups)
-    if (!byGroup.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
+    if (!present.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
   for (const auto& g : o.trainOnly)
-    if (!byGroup.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
+    if (!present.count(g)) throw std::runtime_error(o.data.string() + ": no group '" + g + "'");
+  const boosting::Split split = boosting::splitByFrame(entries, o.split, trainOnly);
   std::vector<std::string> trainIds, testIds;
-  for (const auto& g : order) {
-    const auto& ids = byGroup[g];
-    const std::size_t n = trainOnly.count(g) ? ids.size()
-                                              : static_cast<std::size_t>(std::lround(double(ids.size()) * o.split));
-    trainIds.insert(trainIds.end(), ids.begin(), ids.begin() + static_cast<std::ptrdiff_t>(n));
-    testIds.insert(testIds.end(), ids.begin() + static_cast<std::ptrdiff_t>(n), ids.end());
-    if (talk)
-      std::fprintf(stderr, "group %s: %zu items, %zu train, %zu held back\n", g.c_str(), ids.size(), n,
-                   ids.size() - n);
+  for (const auto& e : split.train) trainIds.push_back(e.id);
+  for (const auto& e : split.test) testIds.push_back(e.id);
+  if (talk) {
+    std::map<std::string, std::pair<std::size_t, std::size_t>> perGroup;
+    std::vector<std::string> order;
+    for (const auto& e : entries)
+      if (!perGroup.count(e.group)) order.push_back(e.group), perGroup[e.group];
+    for (const auto& e : split.train) perGroup[e.group].first++;
+    for (const auto& e : split.test) perGroup[e.group].second++;
+    for (const auto& g : order)
+      std::fprintf(stderr, "group %s: %zu items, %zu train, %zu held back\n", g.c_str(),
+                   perGroup[g].first + perGroup[g].second, perGroup[g].first, perGroup[g].second);
   }
   if (trainIds.empty()) throw std::runtime_error(o.data.string() + ": no training items selected");
   if (!o.testList.empty() && talk) {

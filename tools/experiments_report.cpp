@@ -22,33 +22,21 @@ std::string num(double v, int decimals = 2) {
   return buf;
 }
 
+json orNull(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
+
+json estimateJson(const Estimate& e) {
+  json j{{"value", orNull(e.value)}};
+  if (e.interval)
+    j["ci95"] = {e.interval->lo, e.interval->hi};
+  else
+    j["ci95"] = nullptr;
+  return j;
+}
+
 const ConfigResult* find(const ExperimentReport& r, const std::string& cls, const std::string& config) {
   for (const ConfigResult& c : r.results)
     if (c.className == cls && c.config == config) return &c;
   return nullptr;
-}
-
-// The rows every results table has, in the paper's order plus our extra columns.
-struct Row {
-  std::string name;
-  std::string (*cell)(const ConfigResult&);
-};
-const std::vector<Row>& rows() {
-  static const std::vector<Row> r = {
-      {"length", [](const ConfigResult& c) { return c.trained ? std::to_string(c.length) : std::string("-"); }},
-      {"stages", [](const ConfigResult& c) { return c.trained ? std::to_string(c.stages) : std::string("-"); }},
-      {"recall", [](const ConfigResult& c) { return num(c.counts.recall()); }},
-      {"precision", [](const ConfigResult& c) { return num(c.counts.precision()); }},
-      {"F-measure", [](const ConfigResult& c) { return num(c.counts.fMeasure()); }},
-      {"hits / false alarms / misses",
-       [](const ConfigResult& c) {
-         return std::to_string(c.counts.hits) + " / " + std::to_string(c.counts.falseAlarms) + " / " +
-                std::to_string(c.counts.misses);
-       }},
-      {"ms per stack", [](const ConfigResult& c) { return num(c.msPerStack, 1); }},
-      {"training time [s]", [](const ConfigResult& c) { return c.trained ? num(c.trainSeconds, 1) : std::string("-"); }},
-  };
-  return r;
 }
 
 void table(std::ostringstream& md, const std::vector<std::string>& header,
@@ -66,37 +54,19 @@ void table(std::ostringstream& md, const std::vector<std::string>& header,
   md << "\n";
 }
 
-// Fewer test positives than this make a comparison a coin toss: the claim is "undecided".
-constexpr std::size_t kMinPositivesForClaim = 5;
-
-// A claim "a >= b" on F-measure, with both numbers; null when either was not evaluated.
-// verdict: "holds", "does not hold", or "undecided" (too few test positives, or both F are 0).
-json compare(const ConfigResult* a, const ConfigResult* b) {
-  if (!a || !b) return nullptr;
-  const double fa = a->counts.fMeasure(), fb = b->counts.fMeasure();
-  const bool undecided = a->counts.positives < kMinPositivesForClaim || (fa == 0 && fb == 0);
-  return json{{"lhs", a->config},
-              {"rhs", b->config},
-              {"lhs_f_measure", fa},
-              {"rhs_f_measure", fb},
-              {"lhs_length", a->length},
-              {"rhs_length", b->length},
-              {"test_positives", a->counts.positives},
-              {"holds", fa >= fb},
-              {"verdict", undecided ? "undecided" : (fa >= fb ? "holds" : "does not hold")}};
-}
-
-std::string claimText(const json& c, const std::string& what) {
-  if (c.is_null()) return "- " + what + ": not evaluated\n";
-  char buf[320];
-  std::snprintf(buf, sizeof buf, "- %s: **%s** (F %.2f vs %.2f; length %zu vs %zu; %zu test positives)\n",
-                what.c_str(), c["verdict"].get<std::string>().c_str(), c["lhs_f_measure"].get<double>(),
-                c["rhs_f_measure"].get<double>(), c["lhs_length"].get<std::size_t>(),
-                c["rhs_length"].get<std::size_t>(), c["test_positives"].get<std::size_t>());
-  return buf;
+std::string captionOf(const std::string& config) {
+  for (const ConfigInfo& i : paperConfigs())
+    if (i.config == config) return i.caption;
+  return config;
 }
 
 }  // namespace
+
+std::string formatEstimate(const Estimate& e, int decimals) {
+  std::string s = boosting::formatMeasure(e.value, decimals);
+  if (e.value && e.interval) s += " [" + num(e.interval->lo, decimals) + ", " + num(e.interval->hi, decimals) + "]";
+  return s;
+}
 
 const std::vector<ConfigInfo>& paperConfigs() {
   static const std::vector<ConfigInfo> c = {
@@ -123,120 +93,127 @@ std::vector<std::string> orderedLayers(const std::map<std::string, double>& shar
   return out;
 }
 
-json claimsJson(const ExperimentReport& r, const std::string& cls) {
-  const ConfigResult* all = find(r, cls, "all");
-  json j;
-  j["joint_ge_laser"] = compare(all, find(r, cls, "laser"));
-  j["joint_ge_camera"] = compare(all, find(r, cls, "camera"));
-  j["joint_ge_and"] = compare(all, find(r, cls, "and"));
-  j["four_ge_and"] = compare(find(r, cls, "four"), find(r, cls, "and"));
-  j["corners_help"] = compare(all, find(r, cls, "no_corners"));
-  return j;
-}
-
 std::string renderMarkdown(const ExperimentReport& r) {
   std::ostringstream md;
   md << "# " << r.title << "\n\n";
-  md << "Produced by `" << r.command << "` in " << num(r.totalSeconds / 60.0, 1)
-     << " min. Reproduction of the experiments of Klein, Schulz, Frintrop, \"Boosting with a Joint "
-        "Feature Pool from Different Sensors\" (Tab. 2-7, Fig. 7) on this data set. "
-        "`results.json` holds the same numbers.\n\n";
-
-  md << "## Data\n\n" << r.dataDescription << "\n\n";
-  md << "Stacks: " << r.trainStacks << " training, " << r.testStacks << " test.\n\n";
+  md << "Produced by `" << r.command << "` in " << num(r.totalSeconds / 60.0, 1) << " min";
+  if (r.loadAverage >= 0) md << " (load average " << num(r.loadAverage, 1) << " at the end, shared 2-core machine)";
+  md << ". Cross-drive validation of the experiments of Klein, Schulz, Frintrop, \"Boosting with a Joint "
+        "Feature Pool from Different Sensors\" (Tab. 2-7, Fig. 7): every fold tests on drives its cascades "
+        "never saw. `results.json` holds the same numbers.\n\n";
+  md << "## Data and protocol\n\n" << r.dataDescription << "\n\n";
   {
     std::vector<std::vector<std::string>> body;
-    for (const SplitCounts& c : r.counts)
-      body.push_back({c.className, std::to_string(c.trainPositives), std::to_string(c.trainIgnored),
-                      std::to_string(c.trainFrames), std::to_string(c.testPositives),
-                      std::to_string(c.testIgnored), std::to_string(c.testFrames)});
-    table(md,
-          {"class", "train positives", "train ignored labels", "train frames with class", "test positives",
-           "test ignored labels", "test frames with class"},
+    for (const ClassCounts& c : r.counts)
+      body.push_back({c.className, std::to_string(c.positives), std::to_string(c.ignoredLabels),
+                      std::to_string(c.frames), std::to_string(c.drivesWithPositives)});
+    table(md, {"class", "positives (moderate)", "ignored labels", "frames with a positive", "drives with a positive"},
           body);
   }
+  md << "Evaluation: the KITTI object devkit's 2D rules (boost/evaluation.h). A detection hits a label "
+        "at IoU >= 0.5. Positives are KITTI \"moderate\": box height >= 25 px, occlusion <= 1, "
+        "truncation <= 0.3 (the tracking-label drives 0005 and 0009 store truncation levels 0/1/2: "
+        "level 0 passes, levels 1 and 2 do not). Labels of the class below moderate and of the "
+        "neighbouring class (Van for car, Person_sitting for person) are ignored: a detection on them "
+        "counts neither way. DontCare regions absorb detections inside them; Truck, Tram and Misc are "
+        "false alarms; detections lower than 25 px are ignored. Precision without any detection is "
+        "undefined (null), never 1. F is measured at the operating point (every detection the "
+        "cascade outputs after grouping); AP interpolates precision at 40 recall points (KITTI since "
+        "2019; 11 points before) over the ranking by score (= grouped hits), which ends at the "
+        "operating point, so AP <= the area the detector reaches. Intervals: 95 % percentile "
+        "bootstrap over frames (fixed seed), all folds pooled.\n\n";
   if (!r.settings.empty()) {
     md << "## Settings\n\n";
     std::vector<std::vector<std::string>> body;
     for (const auto& [k, v] : r.settings) body.push_back({k, "`" + v + "`"});
     table(md, {"setting", "value"}, body);
   }
-
-  if (!r.failures.empty()) {
-    md << "## Not evaluated\n\n";
-    for (const std::string& f : r.failures) md << "- " << f << "\n";
-    md << "\n";
-  }
-  md << "## Results in the paper's layout\n\n"
-        "Length is the number of weak classifiers (stumps) in the cascade, summed over both cascades "
-        "for the AND combination. Recall, precision and F-measure on the test frames: a detection "
-        "hits a label with IoU >= 0.5; labels below KITTI \"moderate\" (height < 25 px or occlusion "
-        "> 1) and ignore regions are neither hits nor false alarms. ms per stack: detection time on "
-        "one test stack (all scales), single thread.\n\n";
-  for (const ConfigInfo& info : paperConfigs()) {
-    std::vector<std::string> header{""};
-    std::vector<const ConfigResult*> cols;
-    for (const std::string& cls : r.classes)
-      if (const ConfigResult* c = find(r, cls, info.config)) {
-        header.push_back(cls);
-        cols.push_back(c);
-      }
-    if (cols.empty()) continue;
-    md << "### " << info.caption << "\n\n";
+  if (!r.goals.empty()) {
+    md << "## Goals (issue 15), cross-drive\n\n";
     std::vector<std::vector<std::string>> body;
-    for (const Row& row : rows()) {
-      std::vector<std::string> line{row.name};
-      for (const ConfigResult* c : cols) line.push_back(row.cell(*c));
-      body.push_back(line);
+    for (const Goal& g : r.goals) {
+      const bool met = g.measured.value && *g.measured.value >= g.target;
+      body.push_back({g.className, g.text, formatEstimate(g.measured), met ? "met" : "**not met**"});
     }
-    if (info.config == "all") {
-      std::vector<std::string> line{"corner features"};
-      for (const ConfigResult* c : cols) line.push_back(num(100 * c->cornerShare, 0) + " %");
-      body.push_back(line);
-    }
-    table(md, header, body);
+    table(md, {"class", "goal", "measured F [95 % CI]", ""}, body);
   }
-
-  // Peers: configurations that are not ours.
-  std::vector<const ConfigResult*> peers;
-  for (const ConfigResult& c : r.results)
-    if (!c.trained) peers.push_back(&c);
-  if (!peers.empty()) {
-    md << "### Camera-only peers (OpenCV) on the same test frames\n\n";
-    std::vector<std::string> header{""};
-    for (const ConfigResult* p : peers) header.push_back(p->className + ": " + p->config);
-    std::vector<std::vector<std::string>> body;
-    for (const Row& row : rows()) {
-      std::vector<std::string> line{row.name};
-      for (const ConfigResult* p : peers) line.push_back(row.cell(*p));
-      body.push_back(line);
-    }
-    table(md, header, body);
-    for (const ConfigResult* p : peers) md << "- `" << p->config << "`: " << p->description << "\n";
-    md << "\n";
-  }
-
-  md << "## Per class\n\n";
+  md << "## Results per class (pooled over folds)\n\n"
+        "Length: weak classifiers (stumps) per cascade, mean over folds (AND: both cascades). "
+        "ms per stack: detection on one test stack, one thread.\n\n";
   for (const std::string& cls : r.classes) {
     std::vector<std::vector<std::string>> body;
     for (const ConfigResult& c : r.results) {
       if (c.className != cls) continue;
-      body.push_back({c.config, c.trained ? std::to_string(c.length) : "-", num(c.counts.recall()),
-                      num(c.counts.precision()), num(c.counts.fMeasure()), num(c.msPerStack, 1),
-                      c.trained ? num(c.trainSeconds, 1) : "-", c.stopReason.empty() ? "" : c.stopReason});
+      body.push_back({c.config, formatEstimate(c.f), formatEstimate(c.ap), boosting::formatMeasure(c.counts.recall()),
+                      boosting::formatMeasure(c.counts.precision()),
+                      std::to_string(c.counts.hits) + " / " + std::to_string(c.counts.falseAlarms) + " / " +
+                          std::to_string(c.counts.misses),
+                      c.trained ? num(c.meanLength, 0) : "-", num(c.msPerStack, 1),
+                      c.trained ? num(c.trainSeconds, 0) + (c.cachedFolds ? " (" + std::to_string(c.cachedFolds) + " cached)" : "") : "-",
+                      c.failures.empty() ? "" : std::to_string(c.failures.size())});
     }
     if (body.empty()) continue;
     md << "### " << cls << "\n\n";
-    table(md, {"configuration", "length", "recall", "precision", "F-measure", "ms per stack", "training [s]",
-               "training stopped because"},
+    table(md, {"configuration", "F [95 % CI]", "AP [95 % CI]", "recall", "precision", "hits / false alarms / misses",
+               "length", "ms per stack", "training [s]", "untrained folds"},
           body);
+    md << "![precision-recall " << cls << "](pr_" << cls << ".png)\n\n";
+  }
+  {
+    std::vector<std::string> lines;
+    for (const ConfigResult& c : r.results) {
+      if (!c.trained && !c.description.empty()) lines.push_back("- `" + c.config + "` (" + c.className + "): " + c.description);
+      else if (c.trained) lines.push_back("- `" + c.config + "`: " + (c.description.empty() ? captionOf(c.config) : c.description));
+    }
+    std::sort(lines.begin(), lines.end());
+    lines.erase(std::unique(lines.begin(), lines.end()), lines.end());
+    md << "Configurations:\n\n";
+    for (const auto& l : lines) md << l << "\n";
+    md << "\n";
+  }
+  std::vector<std::string> failures;
+  for (const ConfigResult& c : r.results)
+    for (const auto& f : c.failures) failures.push_back(c.className + " / " + c.config + ", " + f);
+  if (!failures.empty()) {
+    md << "### Folds that could not be trained (they count as detecting nothing)\n\n";
+    for (const auto& f : failures) md << "- " << f << "\n";
+    md << "\n";
+  }
+
+  md << "## The paper's claims, judged with paired bootstrap intervals\n\n"
+        "Difference of F (and AP) between the two configurations on the same resampled frames. "
+        "\"holds\": the 95 % interval of the difference lies above 0; \"contradicted\": below 0; "
+        "\"not shown\": it contains 0 (a tie is not a win).\n\n";
+  {
+    std::vector<std::vector<std::string>> body;
+    for (const Claim& c : r.claims)
+      body.push_back({c.className, c.text, formatEstimate(c.fDifference), "**" + c.verdict + "**",
+                      formatEstimate(c.apDifference), c.apVerdict});
+    if (!body.empty())
+      table(md, {"class", "claim", "F difference [95 % CI]", "verdict (F)", "AP difference [95 % CI]", "verdict (AP)"},
+            body);
+  }
+  if (!r.learning.empty()) {
+    md << "## Learning curves (F against the number of training drives)\n\n"
+          "Configuration `all` per class. Each fold keeps its held-out drive(s) and trains on a seeded "
+          "random subset of the other drives (nested: a larger subset contains the smaller); pooled "
+          "over folds. A curve still rising at the right end says more drives would help (data "
+          "limits); a flat one says the method does.\n\n";
+    std::vector<std::vector<std::string>> body;
+    for (const LearningPoint& p : r.learning)
+      body.push_back({p.className, std::to_string(p.drives), formatEstimate(p.f), formatEstimate(p.ap),
+                      std::to_string(p.counts.hits) + " / " + std::to_string(p.counts.falseAlarms) + " / " +
+                          std::to_string(p.counts.misses)});
+    table(md, {"class", "training drives per fold", "F [95 % CI]", "AP [95 % CI]", "hits / false alarms / misses"},
+          body);
+    for (const std::string& cls : r.classes) md << "![learning curve " << cls << "](learning_" << cls << ".png)\n";
+    md << "\n";
   }
 
   md << "## Weight share by layer (paper Fig. 7)\n\n"
-        "Cascades trained on all layers, decomposed into their weak classifiers. The weight of a "
-        "stump is the difference of its two leaf values, |right - left|: the amount it moves the "
-        "stage sum between its two sides (a constant offset, the mean of the leaves, only shifts the "
-        "stage threshold). Shares are weights summed per layer over all stages, divided by the total.\n\n";
+        "Cascades of configuration `all`, all folds together. The weight of a stump is |right - left|: "
+        "the amount it moves the stage sum between its two sides. Shares are weights summed per layer, "
+        "divided by the total.\n\n";
   {
     std::map<std::string, double> allLayers;
     for (const std::string& cls : r.classes)
@@ -245,6 +222,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
     const std::vector<std::string> layers = orderedLayers(allLayers);
     std::vector<std::string> header{"class"};
     header.insert(header.end(), layers.begin(), layers.end());
+    header.push_back("corner features");
     std::vector<std::vector<std::string>> body;
     for (const std::string& cls : r.classes) {
       const ConfigResult* c = find(r, cls, "all");
@@ -254,6 +232,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
         const auto it = c->layerWeightShare.find(l);
         line.push_back(num(it == c->layerWeightShare.end() ? 0.0 : 100 * it->second, 1) + " %");
       }
+      line.push_back(num(100 * c->cornerShare, 0) + " %");
       body.push_back(line);
     }
     if (!body.empty()) table(md, header, body);
@@ -261,19 +240,9 @@ std::string renderMarkdown(const ExperimentReport& r) {
       if (find(r, cls, "all")) md << "![weight share " << cls << "](weight_share_" << cls << ".png)\n";
     md << "\n";
   }
-
-  md << "## The paper's claims on this data\n\n"
-        "Compared on the F-measure of the test frames (ties count as holding); lengths for the "
-        "paper's second argument, shorter cascades. \"undecided\": fewer than 5 test positives, or F = 0 "
-        "on both sides.\n\n";
-  for (const std::string& cls : r.classes) {
-    const json c = claimsJson(r, cls);
-    md << "### " << cls << "\n\n";
-    md << claimText(c["joint_ge_laser"], "joint pool (all layers) >= laser only");
-    md << claimText(c["joint_ge_camera"], "joint pool (all layers) >= camera only");
-    md << claimText(c["four_ge_and"], "joint pool (4 layers) >= AND of laser-only and camera-only");
-    md << claimText(c["joint_ge_and"], "joint pool (all layers) >= AND of laser-only and camera-only");
-    md << claimText(c["corners_help"], "corner features help (all >= all without corners)");
+  if (!r.notes.empty()) {
+    md << "## Notes\n\n";
+    for (const auto& n : r.notes) md << "- " << n << "\n";
     md << "\n";
   }
   return md.str();
@@ -284,46 +253,66 @@ json toJson(const ExperimentReport& r) {
   j["title"] = r.title;
   j["command"] = r.command;
   j["data"] = r.dataDescription;
-  j["train_stacks"] = r.trainStacks;
-  j["test_stacks"] = r.testStacks;
+  j["folds"] = r.folds;
+  j["stacks"] = r.stacks;
   j["total_seconds"] = r.totalSeconds;
+  j["load_average"] = r.loadAverage;
   j["settings"] = r.settings;
-  j["failures"] = r.failures;
+  j["notes"] = r.notes;
   j["counts"] = json::array();
-  for (const SplitCounts& c : r.counts)
-    j["counts"].push_back({{"class", c.className},
-                           {"train", {{"positives", c.trainPositives}, {"ignored_labels", c.trainIgnored}, {"frames", c.trainFrames}}},
-                           {"test", {{"positives", c.testPositives}, {"ignored_labels", c.testIgnored}, {"frames", c.testFrames}}}});
+  for (const ClassCounts& c : r.counts)
+    j["counts"].push_back({{"class", c.className}, {"positives", c.positives}, {"ignored_labels", c.ignoredLabels},
+                           {"frames", c.frames}, {"drives_with_positives", c.drivesWithPositives}});
   j["results"] = json::array();
   for (const ConfigResult& c : r.results) {
+    json curve = json::array();
+    for (const auto& p : c.curve)
+      curve.push_back({{"threshold", p.threshold}, {"recall", p.recall}, {"precision", p.precision},
+                       {"hits", p.hits}, {"false_alarms", p.falseAlarms}});
     json e{{"class", c.className},
            {"config", c.config},
            {"description", c.description},
            {"trained", c.trained},
            {"layers", c.layers},
-           {"recall", c.counts.recall()},
-           {"precision", c.counts.precision()},
-           {"f_measure", c.counts.fMeasure()},
+           {"f_measure", estimateJson(c.f)},
+           {"average_precision", estimateJson(c.ap)},
+           {"recall", orNull(c.counts.recall())},
+           {"precision", orNull(c.counts.precision())},
            {"hits", c.counts.hits},
            {"false_alarms", c.counts.falseAlarms},
            {"misses", c.counts.misses},
            {"positives", c.counts.positives},
            {"ignored_detections", c.counts.ignored},
            {"stacks", c.counts.stacks},
-           {"ms_per_stack", c.msPerStack}};
+           {"ms_per_stack", c.msPerStack},
+           {"pr_curve", curve},
+           {"failures", c.failures}};
     if (c.trained) {
-      e["length"] = c.length;
-      e["stages"] = c.stages;
-      e["pool_size"] = c.poolSize;
+      e["mean_length"] = c.meanLength;
+      e["mean_stages"] = c.meanStages;
+      e["folds"] = c.folds;
+      e["cached_folds"] = c.cachedFolds;
       e["train_seconds"] = c.trainSeconds;
       e["layer_weight_share"] = c.layerWeightShare;
       e["corner_share"] = c.cornerShare;
-      e["stop_reason"] = c.stopReason;
     }
     j["results"].push_back(std::move(e));
   }
-  j["claims"] = json::object();
-  for (const std::string& cls : r.classes) j["claims"][cls] = claimsJson(r, cls);
+  j["claims"] = json::array();
+  for (const Claim& c : r.claims)
+    j["claims"].push_back({{"class", c.className}, {"key", c.key}, {"claim", c.text}, {"lhs", c.lhs}, {"rhs", c.rhs},
+                           {"f_difference", estimateJson(c.fDifference)}, {"verdict", c.verdict},
+                           {"ap_difference", estimateJson(c.apDifference)}, {"ap_verdict", c.apVerdict}});
+  j["learning_curve"] = json::array();
+  for (const LearningPoint& p : r.learning)
+    j["learning_curve"].push_back({{"class", p.className}, {"drives", p.drives}, {"f_measure", estimateJson(p.f)},
+                                   {"average_precision", estimateJson(p.ap)}, {"hits", p.counts.hits},
+                                   {"false_alarms", p.counts.falseAlarms}, {"misses", p.counts.misses}});
+  j["goals"] = json::array();
+  for (const Goal& g : r.goals)
+    j["goals"].push_back({{"class", g.className}, {"goal", g.text}, {"target", g.target},
+                          {"f_measure", estimateJson(g.measured)},
+                          {"met", g.measured.value.has_value() && *g.measured.value >= g.target}});
   return j;
 }
 
@@ -362,45 +351,45 @@ cv::Mat weightShareChart(const std::string& title, const std::map<std::string, d
   return img;
 }
 
-cv::Mat detectionMosaic(const std::vector<MosaicTile>& tiles, int tileWidth, int columns) {
-  if (tiles.empty() || columns < 1 || tileWidth < 16) return {};
-  std::vector<cv::Mat> drawn;
-  int tileH = 0;
-  for (const MosaicTile& t : tiles) {
-    const double s = static_cast<double>(tileWidth) / t.bgr.cols;
-    cv::Mat img;
-    cv::resize(t.bgr, img, {}, s, s, cv::INTER_AREA);
-    const auto rect = [s](const Box& b) {
-      return cv::Rect(static_cast<int>(std::lround(b.x * s)), static_cast<int>(std::lround(b.y * s)),
-                      static_cast<int>(std::lround(b.w * s)), static_cast<int>(std::lround(b.h * s)));
-    };
-    for (std::size_t i = 0; i < t.labels.size(); ++i) {
-      const auto role = i < t.match.labelRoles.size() ? t.match.labelRoles[i] : boosting::LabelRole::kBackground;
-      if (role == boosting::LabelRole::kPositive)
-        cv::rectangle(img, rect(t.labels[i].box), cv::Scalar(255, 80, 0), 1);
-      else if (role != boosting::LabelRole::kBackground)
-        cv::rectangle(img, rect(t.labels[i].box), cv::Scalar(150, 150, 150), 1);
-    }
-    for (std::size_t i = 0; i < t.detections.size(); ++i) {
-      const auto o = i < t.match.detections.size() ? t.match.detections[i] : boosting::DetectionOutcome::kIgnored;
-      const cv::Scalar c = o == boosting::DetectionOutcome::kHit          ? cv::Scalar(0, 200, 0)
-                           : o == boosting::DetectionOutcome::kFalseAlarm ? cv::Scalar(0, 0, 255)
-                                                                          : cv::Scalar(0, 220, 220);
-      cv::rectangle(img, rect(t.detections[i].box), c, 2);
-    }
-    cv::rectangle(img, cv::Rect(0, 0, img.cols, 18), cv::Scalar(0, 0, 0), cv::FILLED);
-    cv::putText(img, t.caption, {4, 13}, cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(255, 255, 255), 1, cv::LINE_AA);
-    tileH = std::max(tileH, img.rows);
-    drawn.push_back(img);
+cv::Mat lineChart(const std::string& title, const std::string& xLabel, const std::string& yLabel, double xMax,
+                  const std::vector<Series>& series) {
+  const int left = 60, top = 40, plotW = 460, plotH = 300, right = 190, bottom = 50;
+  cv::Mat img(top + plotH + bottom, left + plotW + right, CV_8UC3, cv::Scalar(255, 255, 255));
+  const auto font = cv::FONT_HERSHEY_SIMPLEX;
+  cv::putText(img, title, {left, 26}, font, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  const double xm = xMax > 0 ? xMax : 1;
+  const auto px = [&](double x, double y) {
+    return cv::Point(left + static_cast<int>(std::lround(plotW * std::clamp(x / xm, 0.0, 1.0))),
+                     top + plotH - static_cast<int>(std::lround(plotH * std::clamp(y, 0.0, 1.0))));
+  };
+  for (int t = 0; t <= 10; t += 2) {
+    const cv::Point a = px(0, t / 10.0), b = px(xm, t / 10.0);
+    cv::line(img, a, b, cv::Scalar(225, 225, 225), 1);
+    cv::putText(img, num(t / 10.0, 1), {a.x - 34, a.y + 4}, font, 0.4, cv::Scalar(80, 80, 80), 1, cv::LINE_AA);
+    const cv::Point c = px(xm * t / 10.0, 0);
+    cv::putText(img, num(xm * t / 10.0, xm > 2 ? 0 : 1), {c.x - 10, c.y + 18}, font, 0.4, cv::Scalar(80, 80, 80), 1,
+                cv::LINE_AA);
   }
-  const int rowsN = (static_cast<int>(drawn.size()) + columns - 1) / columns;
-  const int colsN = std::min(columns, static_cast<int>(drawn.size()));
-  cv::Mat mosaic(rowsN * (tileH + 4), colsN * (tileWidth + 4), CV_8UC3, cv::Scalar(40, 40, 40));
-  for (std::size_t i = 0; i < drawn.size(); ++i) {
-    const int r = static_cast<int>(i) / columns, c = static_cast<int>(i) % columns;
-    drawn[i].copyTo(mosaic(cv::Rect(c * (tileWidth + 4), r * (tileH + 4), drawn[i].cols, drawn[i].rows)));
+  cv::rectangle(img, px(0, 1), px(xm, 0), cv::Scalar(0, 0, 0), 1);
+  cv::putText(img, xLabel, {left + plotW / 2 - 40, top + plotH + 40}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  cv::putText(img, yLabel, {4, top - 8}, font, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  static const cv::Scalar colours[] = {{190, 120, 40}, {40, 130, 230}, {60, 170, 60},  {40, 40, 200},
+                                       {160, 60, 160}, {30, 30, 30},   {0, 180, 200}, {120, 120, 120}};
+  for (std::size_t s = 0; s < series.size(); ++s) {
+    const cv::Scalar colour = colours[s % std::size(colours)];
+    const auto& pts = series[s].points;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const cv::Point p = px(pts[i].first, pts[i].second);
+      cv::circle(img, p, 3, colour, cv::FILLED, cv::LINE_AA);
+      if (i > 0) cv::line(img, px(pts[i - 1].first, pts[i - 1].second), p, colour, 2, cv::LINE_AA);
+      if (i < series[s].band.size())
+        cv::line(img, px(pts[i].first, series[s].band[i].first), px(pts[i].first, series[s].band[i].second), colour, 1);
+    }
+    const int ly = top + 14 + static_cast<int>(s) * 20;
+    cv::line(img, {left + plotW + 14, ly - 4}, {left + plotW + 34, ly - 4}, colour, 2);
+    cv::putText(img, series[s].name, {left + plotW + 40, ly}, font, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
-  return mosaic;
+  return img;
 }
 
 void writeReport(const std::filesystem::path& dir, const ExperimentReport& report) {

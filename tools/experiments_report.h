@@ -1,60 +1,96 @@
 #pragma once
-// `fusedet experiments`, output side: report.md (tables shaped like the paper's Tab. 2-7 plus a
-// per-class comparison and the paper's claims checked on the measured numbers), results.json,
-// the weight-share-by-layer bar chart per class (paper Fig. 7) and the detection mosaics.
+// `fusedet experiments`, output side: report.md (cross-drive tables with 95 % bootstrap intervals,
+// the paper's claims judged with paired intervals, learning curves, goals), results.json, and the
+// charts: precision-recall curves and learning curve per class, weight share by layer (Fig. 7).
+// The numbers come from the library (boost/cross_validation.h, bootstrap.h); this only prints.
 
 #include <filesystem>
 #include <map>
 #include <nlohmann/json_fwd.hpp>
 #include <opencv2/core/mat.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/evaluation.h"
-#include "fusedet/core/detection.h"
-#include "fusedet/core/label.h"
+#include "fusedet/boost/precision_recall.h"
 
 namespace fusedet::tools::experiments {
 
-// One configuration (trained pool subset, AND combination or peer) evaluated for one class.
+// A measure on the pooled frames and its 95 % bootstrap interval over frames.
+struct Estimate {
+  std::optional<double> value;
+  std::optional<boosting::Interval> interval;
+};
+
+// One configuration (trained pool subset, AND combination or peer) for one class, pooled over
+// the folds.
 struct ConfigResult {
   std::string className;
   std::string config;       // "all", "no_corners", "laser", "camera", "four", "and", "hog", ...
   std::string description;  // what it is, for the report
   bool trained = true;      // false for peers (no length, training time, weight shares)
   std::vector<std::string> layers;
-  std::size_t poolSize = 0;  // candidate features (0 for peers and AND)
-  std::size_t length = 0;    // weak classifiers (AND: both cascades together)
-  std::size_t stages = 0;
-  boosting::Counts counts;
+  double meanLength = 0, meanStages = 0;  // over the trained folds (AND: both cascades)
+  boosting::Counts counts;                // pooled at the operating point
+  Estimate f, ap;                         // F at the operating point; AP (KITTI, 40 recall points)
+  std::vector<boosting::PrPoint> curve;
   double msPerStack = 0;
-  double trainSeconds = 0;
-  std::map<std::string, double> layerWeightShare;  // layer -> share of the summed weight, sums to 1
-  double cornerShare = 0;                          // share of weak classifiers that are corners
-  std::string stopReason;                          // why training stopped, as the trainer said it
+  double trainSeconds = 0;                          // summed over folds (0 for cached folds)
+  std::map<std::string, double> layerWeightShare;   // over all folds' cascades, sums to 1
+  double cornerShare = 0;                           // share of weak classifiers that are corners
+  std::size_t folds = 0, cachedFolds = 0;
+  std::vector<std::string> failures;                // folds that could not be trained, and why
 };
 
-// Counts of one class in one split.
-struct SplitCounts {
+// "a is better than b", judged on the paired bootstrap interval of the difference.
+struct Claim {
+  std::string className, key, text, lhs, rhs;
+  Estimate fDifference, apDifference;
+  std::string verdict;    // on F: "holds", "contradicted", "not shown"
+  std::string apVerdict;  // the same on AP
+};
+
+// One point of a learning curve: a class's "all" configuration trained on `drives` drives per fold.
+struct LearningPoint {
   std::string className;
-  std::size_t trainPositives = 0, trainIgnored = 0, trainFrames = 0;
-  std::size_t testPositives = 0, testIgnored = 0, testFrames = 0;
+  std::size_t drives = 0;  // training drives per fold (at most)
+  boosting::Counts counts;
+  Estimate f, ap;
+};
+
+struct ClassCounts {
+  std::string className;
+  std::size_t positives = 0, ignoredLabels = 0, frames = 0, drivesWithPositives = 0;
+};
+
+// A goal of the issue ("car F >= 0.8"): the measured F, its interval and whether it is met.
+struct Goal {
+  std::string className, text;
+  double target = 0;
+  Estimate measured;
 };
 
 struct ExperimentReport {
-  std::string title = "fusedet experiments";
-  std::string command;                    // the command line that produced it
-  std::string dataDescription;            // data set and split, one paragraph
-  std::size_t trainStacks = 0, testStacks = 0;
-  std::vector<std::string> classes;       // table columns, in order
-  std::vector<SplitCounts> counts;
+  std::string title = "fusedet experiments: cross-drive validation";
+  std::string command;          // the command line that produced it
+  std::string dataDescription;  // data set, drives and folds, one paragraph
+  std::vector<std::string> folds;  // held-out drives of each fold
+  std::size_t stacks = 0;
+  std::vector<std::string> classes;  // table order
+  std::vector<ClassCounts> counts;
   std::vector<ConfigResult> results;
+  std::vector<Claim> claims;
+  std::vector<LearningPoint> learning;
+  std::vector<Goal> goals;
   std::map<std::string, std::string> settings;  // shown in a table and in results.json
-  std::vector<std::string> failures;            // configurations that could not be trained, and why
+  std::vector<std::string> notes;               // facts the run wants the reader to know
   double totalSeconds = 0;
+  double loadAverage = -1;  // 1-minute load average at the end (shared machine), < 0 unknown
 };
 
-// Configurations in the order of the paper's tables, with their table captions.
+// Configurations in the order of the paper's tables, with their captions.
 struct ConfigInfo {
   std::string config, caption;
 };
@@ -63,25 +99,23 @@ const std::vector<ConfigInfo>& paperConfigs();
 // Layer order for charts and tables: the paper's Fig. 3 order, unknown layers after it.
 std::vector<std::string> orderedLayers(const std::map<std::string, double>& shares);
 
+// "0.58 [0.41, 0.72]", "null" when undefined.
+std::string formatEstimate(const Estimate& e, int decimals = 2);
+
 std::string renderMarkdown(const ExperimentReport& report);
 nlohmann::json toJson(const ExperimentReport& report);
-// The paper's claims on the measured numbers of one class (missing configs: not evaluated).
-nlohmann::json claimsJson(const ExperimentReport& report, const std::string& className);
 
 // Bar chart of weight share per layer (paper Fig. 7), one bar per layer, as an 8-bit BGR image.
 cv::Mat weightShareChart(const std::string& title, const std::map<std::string, double>& shares);
 
-// One tile of a detection mosaic: the image with labels and classified detections drawn.
-struct MosaicTile {
-  cv::Mat bgr;
-  Labels labels;
-  std::vector<Detection> detections;
-  boosting::StackMatch match;  // outcomes of `detections` and roles of `labels`
-  std::string caption;
+// A line chart with x and y in [0, xMax] x [0, 1]: one polyline + dots per series, legend.
+struct Series {
+  std::string name;
+  std::vector<std::pair<double, double>> points;  // (x, y)
+  std::vector<std::pair<double, double>> band;    // optional (lo, hi) per point: drawn as whiskers
 };
-// Tiles scaled to `tileWidth`, `columns` per row. Colours: green hit, red false alarm, yellow
-// ignored detection, blue positive label, grey ignored label or region.
-cv::Mat detectionMosaic(const std::vector<MosaicTile>& tiles, int tileWidth = 620, int columns = 2);
+cv::Mat lineChart(const std::string& title, const std::string& xLabel, const std::string& yLabel, double xMax,
+                  const std::vector<Series>& series);
 
 // Writes report.md and results.json into `dir` (created if needed).
 void writeReport(const std::filesystem::path& dir, const ExperimentReport& report);

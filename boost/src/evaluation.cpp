@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 
 #include "fusedet/core/box.h"
@@ -16,13 +17,19 @@ bool contains(const std::vector<std::string>& names, const std::string& name) {
 }  // namespace
 
 LabelRole labelRole(const Label& label, const MatchConfig& config) {
-  if (label.ignore || contains(config.ignoreClasses, label.className)) return LabelRole::kIgnoreRegion;
-  if (label.className != config.className && !contains(config.aliasClasses, label.className))
-    return LabelRole::kBackground;
-  const bool tooSmall = label.box.h < config.minHeight;
-  const bool tooOccluded = label.occlusion > config.maxOcclusion;
-  const bool tooTruncated = config.maxTruncation >= 0 && label.truncation > config.maxTruncation;
-  return (tooSmall || tooOccluded || tooTruncated) ? LabelRole::kIgnoredLabel : LabelRole::kPositive;
+  const auto listed = [&](const std::vector<std::string>& names) {
+    return contains(names, label.className) || contains(names, label.sourceClass);
+  };
+  if (listed(config.ignoreClasses)) return LabelRole::kIgnoreRegion;
+  if (!label.ignore && (label.className == config.className || contains(config.aliasClasses, label.className))) {
+    const bool tooSmall = label.box.h < config.minHeight;
+    const bool tooOccluded = label.occlusion > config.maxOcclusion;
+    const bool tooTruncated = config.maxTruncation >= 0 && label.truncation > config.maxTruncation;
+    return (tooSmall || tooOccluded || tooTruncated) ? LabelRole::kIgnoredLabel : LabelRole::kPositive;
+  }
+  if (listed(config.neighbourClasses)) return LabelRole::kIgnoredLabel;
+  if (label.ignore && !contains(config.falseAlarmClasses, label.sourceClass)) return LabelRole::kIgnoreRegion;
+  return LabelRole::kBackground;
 }
 
 StackMatch matchDetections(const std::vector<Detection>& detections, const Labels& labels,
@@ -47,6 +54,10 @@ StackMatch matchDetections(const std::vector<Detection>& detections, const Label
   for (std::size_t d : order) {
     const Detection& det = detections[d];
     if (!det.className.empty() && det.className != config.className) continue;  // stays kIgnored
+    if (det.box.h < config.minDetectionHeight) {  // the devkit ignores detections below 25 px
+      ++m.ignored;
+      continue;
+    }
     // 1. the best free positive
     int best = -1;
     double bestIou = 0;
@@ -93,20 +104,34 @@ void Counts::add(const StackMatch& m) {
   ++stacks;
 }
 
-double Counts::recall() const {
-  return positives == 0 ? 1.0 : static_cast<double>(hits) / static_cast<double>(positives);
+std::optional<double> Counts::recall() const {
+  if (positives == 0) return std::nullopt;
+  return static_cast<double>(hits) / static_cast<double>(positives);
 }
 
-double Counts::precision() const {
+std::optional<double> Counts::precision() const {
   const std::size_t detected = hits + falseAlarms;
-  return detected == 0 ? 1.0 : static_cast<double>(hits) / static_cast<double>(detected);
+  if (detected == 0) return std::nullopt;
+  return static_cast<double>(hits) / static_cast<double>(detected);
 }
 
 double fMeasure(double recall, double precision) {
   return recall + precision > 0 ? 2 * recall * precision / (recall + precision) : 0.0;
 }
 
-double Counts::fMeasure() const { return boosting::fMeasure(recall(), precision()); }
+std::optional<double> Counts::fMeasure() const {
+  const auto r = recall();
+  if (!r) return std::nullopt;
+  const auto p = precision();
+  return p ? boosting::fMeasure(*r, *p) : 0.0;  // no detection: recall 0, F 0
+}
+
+std::string formatMeasure(const std::optional<double>& value, int decimals) {
+  if (!value) return "null";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, *value);
+  return buf;
+}
 
 namespace {
 

@@ -11,15 +11,17 @@
 #include <set>
 #include <opencv2/core.hpp>
 
-#include "../../tools/experiments_data.h"
 #include "../../tools/experiments_peers.h"
 #include "../../tools/experiments_report.h"
-#include "../../tools/experiments_run.h"
+#include "fusedet/boost/chain_evaluation.h"
+#include "fusedet/boost/class_rules.h"
+#include "fusedet/boost/data_split.h"
 #include "fusedet/fusion/kitti.h"
 
 namespace fusedet::tools::experiments {
 namespace {
 namespace fs = std::filesystem;
+using namespace boosting;
 
 std::vector<DatasetEntry> entries(const std::string& group, int n) {
   std::vector<DatasetEntry> e;
@@ -88,6 +90,7 @@ TEST(ExperimentsRules, CountsMatchTheDataSetsSourceNotes) {
   boosting::MatchConfig every = matchConfigFor("car", VanPolicy::kNegative);
   every.minHeight = 0;
   every.maxOcclusion = 3;
+  every.maxTruncation = -1;
   InstanceCount car = countInstances(frames, every);
   EXPECT_EQ(car.positives, 82u);
   EXPECT_EQ(car.frames, 15u);
@@ -131,40 +134,48 @@ TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
   ExperimentReport r;
   r.command = "fusedet experiments --quick";
   r.classes = {"car"};
-  auto add = [&](std::string config, std::size_t hits, std::size_t fa, std::size_t len) {
-    ConfigResult c;
-    c.className = "car";
-    c.config = std::move(config);
-    c.length = len;
-    c.counts.positives = 10;
-    c.counts.hits = hits;
-    c.counts.misses = 10 - hits;
-    c.counts.falseAlarms = fa;
-    c.layerWeightShare = {{"distance", 0.75}, {"intensity", 0.25}};
-    r.results.push_back(c);
-  };
-  add("all", 9, 1, 20);     // F = 0.9
-  add("laser", 9, 3, 30);   // R .9 P .75 -> F .818
-  add("camera", 10, 0, 40); // F = 1
+  ConfigResult c;
+  c.className = "car";
+  c.config = "all";
+  c.counts.positives = 10;
+  c.counts.hits = 9;
+  c.counts.misses = 1;
+  c.counts.falseAlarms = 1;
+  c.f.value = 0.9;
+  c.f.interval = boosting::Interval{0.8, 0.97, 200};
+  c.layerWeightShare = {{"distance", 0.75}, {"intensity", 0.25}};
+  r.results.push_back(c);
+  ConfigResult none = c;  // a configuration that detected nothing: precision undefined
+  none.config = "camera";
+  none.counts.hits = 0;
+  none.counts.falseAlarms = 0;
+  none.counts.misses = 10;
+  none.f = {0.0, boosting::Interval{0, 0, 200}};
+  r.results.push_back(none);
+  Claim claim;
+  claim.className = "car";
+  claim.key = "joint_gt_camera";
+  claim.text = "joint pool (all layers) > camera only";
+  claim.fDifference = {0.9, boosting::Interval{0.8, 0.97, 200}};
+  claim.verdict = boosting::verdict(claim.fDifference.interval);
+  r.claims.push_back(claim);
+  r.goals.push_back({"car", "F >= 0.8", 0.8, c.f});
   const nlohmann::json j = toJson(r);
-  EXPECT_NEAR(j["results"][0]["f_measure"].get<double>(), 0.9, 1e-12);
-  EXPECT_EQ(j["results"][0]["length"].get<int>(), 20);
-  EXPECT_TRUE(j["claims"]["car"]["joint_ge_laser"]["holds"].get<bool>());
-  EXPECT_FALSE(j["claims"]["car"]["joint_ge_camera"]["holds"].get<bool>());
-  EXPECT_TRUE(j["claims"]["car"]["joint_ge_and"].is_null());
+  EXPECT_NEAR(j["results"][0]["f_measure"]["value"].get<double>(), 0.9, 1e-12);
+  EXPECT_NEAR(j["results"][0]["f_measure"]["ci95"][0].get<double>(), 0.8, 1e-12);
+  EXPECT_TRUE(j["results"][1]["precision"].is_null());
+  EXPECT_EQ(j["claims"][0]["verdict"], "holds");
+  EXPECT_TRUE(j["goals"][0]["met"].get<bool>());
   const std::string md = renderMarkdown(r);
-  EXPECT_NE(md.find("### Tab. 2: all layers"), std::string::npos);
-  EXPECT_NE(md.find("| F-measure | 0.90 |"), std::string::npos) << md;
-  EXPECT_NE(md.find("joint pool (all layers) >= camera only: **does not hold** (F 0.90 vs 1.00"), std::string::npos);
-  EXPECT_EQ(j["claims"]["car"]["joint_ge_laser"]["verdict"], "holds");
-  // With too few test positives a claim is undecided, whatever the numbers.
-  for (ConfigResult& c : r.results) c.counts.positives = 4;
-  EXPECT_EQ(toJson(r)["claims"]["car"]["joint_ge_laser"]["verdict"], "undecided");
-  EXPECT_EQ(md.find("Tab. 7"), std::string::npos);  // not evaluated, no table
-  // Fig. 7 chart: distance (laser) bar three times as high as intensity's.
-  const cv::Mat chart = weightShareChart("car", r.results[0].layerWeightShare);
-  ASSERT_FALSE(chart.empty());
-  EXPECT_EQ(orderedLayers(r.results[0].layerWeightShare), (std::vector<std::string>{"intensity", "distance"}));
+  EXPECT_NE(md.find("| all | 0.90 [0.80, 0.97] | null |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| camera | 0.00 [0.00, 0.00] | null | 0.00 | null |"), std::string::npos) << md;
+  EXPECT_NE(md.find("**holds**"), std::string::npos);
+  // Fig. 7 chart and the line charts are drawn.
+  EXPECT_FALSE(weightShareChart("car", c.layerWeightShare).empty());
+  EXPECT_EQ(orderedLayers(c.layerWeightShare), (std::vector<std::string>{"intensity", "distance"}));
+  const cv::Mat chart = lineChart("pr", "recall", "precision", 1.0, {{"all", {{0.1, 1.0}, {0.5, 0.6}}, {}}});
+  EXPECT_EQ(chart.type(), CV_8UC3);
+  EXPECT_GT(chart.cols, 500);
 }
 
 }  // namespace
@@ -172,6 +183,7 @@ TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
 
 namespace fusedet::tools::experiments {
 namespace {
+using namespace boosting;
 
 // A one-stump cascade on one layer: accepts windows whose left half is brighter than the right.
 boosting::Cascade edgeCascade(const std::string& layerName, double threshold) {
@@ -242,6 +254,7 @@ TEST(ExperimentsRun, EvaluateChainCountsOverItems) {
   setup.group.minNeighbors = 0;
   boosting::MatchConfig match = matchConfigFor("car", VanPolicy::kNegative);
   match.minHeight = 20;  // the 24 px test label would be below KITTI moderate
+  match.minDetectionHeight = 20;
   const EvalOutcome r = evaluateChain({&det}, {item, item}, match, setup);
   EXPECT_EQ(r.counts.stacks, 2u);
   EXPECT_EQ(r.counts.positives, 2u);

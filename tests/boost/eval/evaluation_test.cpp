@@ -78,13 +78,20 @@ TEST(Evaluation, LabelsBelowModerateAreNeitherHitNorFalseAlarm) {
   EXPECT_EQ(matchDetections({}, labels, loose).positives, 3u);
 }
 
-TEST(Evaluation, TruncationLimitOnlyWhenSet) {
+TEST(Evaluation, TruncationLimitIsModerateByDefault) {
   Label l = label("car", {0, 0, 50, 50});
-  l.truncation = 0.4;
+  l.truncation = 0.4;  // object-benchmark fraction above 0.3
+  EXPECT_EQ(labelRole(l, carConfig()), LabelRole::kIgnoredLabel);
+  l.truncation = 0.3;  // exactly the limit
+  EXPECT_EQ(labelRole(l, carConfig()), LabelRole::kPositive);
+  l.truncation = 1;  // tracking level 1 (partly truncated): fails the same numeric test
+  EXPECT_EQ(labelRole(l, carConfig()), LabelRole::kIgnoredLabel);
+  l.truncation = 0;  // tracking level 0
   EXPECT_EQ(labelRole(l, carConfig()), LabelRole::kPositive);
   MatchConfig c = carConfig();
-  c.maxTruncation = 0.3;
-  EXPECT_EQ(labelRole(l, c), LabelRole::kIgnoredLabel);
+  c.maxTruncation = -1;  // not checked
+  l.truncation = 2;
+  EXPECT_EQ(labelRole(l, c), LabelRole::kPositive);
 }
 
 TEST(Evaluation, IgnoreRegionAbsorbsDetectionsMostlyInsideIt) {
@@ -98,7 +105,7 @@ TEST(Evaluation, IgnoreRegionAbsorbsDetectionsMostlyInsideIt) {
   // At x=80: 20/50 = 0.4 inside -> false alarm.
   EXPECT_EQ(matchDetections({det({80, 0, 50, 50})}, labels, carConfig()).falseAlarms, 1u);
   // Several detections may fall into one region.
-  EXPECT_EQ(matchDetections({det({0, 0, 10, 10}), det({20, 20, 10, 10})}, labels, carConfig()).ignored, 2u);
+  EXPECT_EQ(matchDetections({det({0, 0, 30, 30}), det({40, 40, 30, 30})}, labels, carConfig()).ignored, 2u);
 }
 
 TEST(Evaluation, VanIsAHardNegativeUnlessConfigured) {
@@ -167,18 +174,25 @@ TEST(Evaluation, CountsAndMeasures) {
   c.add(a);
   c.add(b);
   EXPECT_EQ(c.stacks, 2u);
-  EXPECT_DOUBLE_EQ(c.recall(), 3.0 / 5.0);
-  EXPECT_DOUBLE_EQ(c.precision(), 3.0 / 4.0);
-  EXPECT_NEAR(c.fMeasure(), 2 * 0.6 * 0.75 / 1.35, 1e-12);
-  // Vacuous cases.
+  EXPECT_DOUBLE_EQ(c.recall().value(), 3.0 / 5.0);
+  EXPECT_DOUBLE_EQ(c.precision().value(), 3.0 / 4.0);
+  EXPECT_NEAR(c.fMeasure().value(), 2 * 0.6 * 0.75 / 1.35, 1e-12);
+  // Undefined cases: nothing to find, nothing detected - never a vacuous 1.
   Counts empty;
-  EXPECT_EQ(empty.recall(), 1.0);
-  EXPECT_EQ(empty.precision(), 1.0);
+  EXPECT_FALSE(empty.recall().has_value());
+  EXPECT_FALSE(empty.precision().has_value());
+  EXPECT_FALSE(empty.fMeasure().has_value());
+  EXPECT_EQ(formatMeasure(empty.precision()), "null");
   Counts missedAll;
   missedAll.positives = 4;
   missedAll.misses = 4;
   EXPECT_EQ(missedAll.recall(), 0.0);
-  EXPECT_EQ(missedAll.fMeasure(), 0.0);
+  EXPECT_FALSE(missedAll.precision().has_value());
+  EXPECT_EQ(missedAll.fMeasure(), 0.0);  // recall 0: F 0 whatever the precision
+  Counts onlyFalseAlarms;
+  onlyFalseAlarms.falseAlarms = 3;
+  EXPECT_EQ(onlyFalseAlarms.precision(), 0.0);
+  EXPECT_FALSE(onlyFalseAlarms.fMeasure().has_value());  // no positives: F undefined
 }
 
 TEST(Evaluation, FMeasureReproducesThePapersTables) {

@@ -1,0 +1,63 @@
+#pragma once
+// Cross-drive validation (data_split.h folds): for each fold a cascade is trained on the training
+// groups' items (labels as trainingLabels() gives them for the class) and run on the held-out
+// items; every item is tested exactly once, so the per-item outcomes pool over the folds into one
+// test set (F, AP, bootstrap intervals over frames: bootstrap.h).
+//
+// Training is the expensive part, so fold models are cached: a model file named by a hash of the
+// training configuration and the training items' ids is reused when present. The key does not
+// see code changes: use a fresh cache directory after changing the trainer.
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/cascade.h"
+#include "fusedet/boost/cascade_trainer.h"
+#include "fusedet/boost/chain_evaluation.h"
+#include "fusedet/boost/data_split.h"
+#include "fusedet/boost/evaluation.h"
+#include "fusedet/core/dataset.h"
+
+namespace fusedet::boosting {
+
+// Text of every setting of a training configuration that changes the model (one per line).
+std::string describeTrainingConfig(const TrainingConfig& config);
+// 16 hex digits: FNV-1a 64 of the description and the training item ids, in order.
+std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds);
+
+// Trains on items[train] (or loads `cacheDir/<key>.json` when it exists; empty cacheDir = no
+// cache) and writes the model there. `fromCache` tells which. Throws what trainCascade throws
+// (e.g. too few positives).
+Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
+                    const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
+                    ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr);
+
+// Outcome of one configuration over all folds.
+struct CrossValidationResult {
+  // Per item. A fold whose cascade cannot be trained (e.g. too few positives) detects nothing: its
+  // positives count as misses, so a failure is never left out of the pooled numbers.
+  std::vector<FrameOutcome> frames;
+  std::vector<std::string> failures;                // "fold <groups>: <why>" of untrained folds
+  std::vector<CascadeSummary> summaries;            // per trained fold
+  double trainSeconds = 0, msPerStack = 0;          // summed training; mean detection time
+  std::size_t cachedFolds = 0;
+};
+
+// A configuration: one or more training configs whose cascades are chained (AND) at detection.
+struct ChainSpec {
+  std::vector<TrainingConfig> parts;
+};
+
+// Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
+// fold's test items. `progress` gets a line per fold.
+CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
+                                    const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
+                                    const MatchConfig& match, const DetectionSetup& setup,
+                                    const std::filesystem::path& cacheDir, ProgressSink& progress,
+                                    const std::function<void(const std::string&)>& log = {});
+
+}  // namespace fusedet::boosting

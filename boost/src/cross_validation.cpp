@@ -1,0 +1,135 @@
+#include "fusedet/boost/cross_validation.h"
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+
+#include "fusedet/boost/model_io.h"
+
+namespace fusedet::boosting {
+namespace {
+
+std::string joined(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
+}
+
+}  // namespace
+
+std::string describeTrainingConfig(const TrainingConfig& c) {
+  std::ostringstream d;
+  d.precision(17);
+  d << "class " << c.className << "\npool grid " << c.pool.grid << " position_step " << c.pool.positionStep
+    << " min_cell " << c.pool.minCellSize << " size_step " << c.pool.sizeStep << " layers " << joined(c.pool.layers)
+    << " types";
+  for (FeatureType t : c.pool.types) d << " " << static_cast<int>(t);
+  d << "\nsamples min_height " << c.samples.minPositiveHeight << " max_occlusion " << c.samples.maxOcclusion
+    << " flip " << c.samples.flipPositives << " max_negative_iou " << c.samples.maxNegativeIou
+    << " max_ignore_coverage " << c.samples.maxIgnoreCoverage << " window_height " << c.samples.baseWindowHeight
+    << " scan " << c.samples.scan.scaleFactor << " " << c.samples.scan.step << " " << c.samples.scan.minWidth << " "
+    << c.samples.scan.minHeight << " " << c.samples.scan.maxWidth << " " << c.samples.scan.maxHeight
+    << "\nstage min_hit " << c.stage.minHit << " max_fa " << c.stage.maxFalseAlarm << " max_weak " << c.stage.maxWeak
+    << " refine " << c.stage.refineTop << "\ncascade target_fa " << c.targetFalseAlarm << " max_stages "
+    << c.maxStages << " negatives " << c.negativesPerStage << " min_negatives " << c.minNegatives
+    << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
+  return d.str();
+}
+
+std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  const auto add = [&](const std::string& s) {
+    for (unsigned char ch : s) h = (h ^ ch) * 0x100000001b3ull;
+    h = (h ^ 0xffu) * 0x100000001b3ull;  // separator
+  };
+  add(describeTrainingConfig(config));
+  for (const std::string& id : itemIds) add(id);
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
+                    const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
+                    ProgressSink& progress, TrainingReport* report, bool* fromCache) {
+  std::vector<DatasetItem> subset;
+  std::vector<std::string> ids;
+  subset.reserve(train.size());
+  for (std::size_t i : train) {
+    subset.push_back(items.at(i));  // layers are shared cv::Mat headers, not copied pixels
+    ids.push_back(items.at(i).id);
+  }
+  const std::string key = trainingKey(config, ids);
+  const std::filesystem::path file = cacheDir.empty() ? std::filesystem::path() : cacheDir / (key + ".json");
+  if (!file.empty() && std::filesystem::exists(file)) {
+    if (fromCache) *fromCache = true;
+    return loadModel(file);
+  }
+  if (fromCache) *fromCache = false;
+  TrainingReport local;
+  Cascade cascade = trainCascade(config, subset, progress, report ? report : &local);
+  if (!file.empty()) {
+    std::filesystem::create_directories(cacheDir);
+    const TrainingReport& r = report ? *report : local;
+    const std::filesystem::path tmp = file.string() + ".tmp";
+    saveModel(cascade, tmp, {{"training_key", key}, {"train_items", std::to_string(ids.size())},
+                             {"stop_reason", r.stopReason}, {"train_seconds", std::to_string(r.seconds)}});
+    std::filesystem::rename(tmp, file);  // a killed run leaves no half-written model
+  }
+  return cascade;
+}
+
+CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
+                                    const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
+                                    const MatchConfig& match, const DetectionSetup& setup,
+                                    const std::filesystem::path& cacheDir, ProgressSink& progress,
+                                    const std::function<void(const std::string&)>& log) {
+  if (spec.parts.empty()) throw std::invalid_argument("crossValidate: no training configuration");
+  if (trainingItems.size() != testItems.size())
+    throw std::invalid_argument("crossValidate: training and test items differ in number");
+  CrossValidationResult out;
+  out.frames.resize(testItems.size());
+  double detectMs = 0;
+  std::size_t detected = 0;
+  for (const Fold& fold : folds) {
+    std::string name;
+    for (const auto& g : fold.testGroups) name += (name.empty() ? "" : "+") + g;
+    std::vector<Detector> detectors;
+    std::vector<CascadeSummary> parts;
+    try {
+      for (const TrainingConfig& part : spec.parts) {
+        bool cached = false;
+        TrainingReport report;
+        const auto t0 = std::chrono::steady_clock::now();
+        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached);
+        out.trainSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        out.cachedFolds += cached ? 1 : 0;
+        parts.push_back(summarizeCascade(c));
+        detectors.emplace_back(std::move(c));
+      }
+    } catch (const std::runtime_error& e) {
+      out.failures.push_back("fold " + name + ": " + e.what());
+      if (log) log("fold " + name + ": not trained (counted as detecting nothing): " + e.what());
+      for (std::size_t i : fold.test) out.frames[i] = frameOutcome({}, matchDetections({}, testItems[i].labels, match));
+      continue;
+    }
+    std::vector<const Detector*> chain;
+    for (const Detector& d : detectors) chain.push_back(&d);
+    const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, setup);
+    for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
+    out.summaries.push_back(parts.size() == 1 ? parts.front() : combineSummaries(parts));
+    detectMs += eval.msPerStack * static_cast<double>(fold.test.size());
+    detected += fold.test.size();
+    if (log) {
+      char line[256];
+      std::snprintf(line, sizeof line, "fold %s: %zu train / %zu test items, %zu hits, %zu false alarms, %zu positives",
+                    name.c_str(), fold.train.size(), fold.test.size(), eval.counts.hits, eval.counts.falseAlarms,
+                    eval.counts.positives);
+      log(line);
+    }
+  }
+  out.msPerStack = detected ? detectMs / static_cast<double>(detected) : 0.0;
+  return out;
+}
+
+}  // namespace fusedet::boosting
