@@ -555,7 +555,7 @@ int runExperiments(ExperimentOptions o) {
     if (cls == "person")
       for (const ConfigResult& r : report.results)
         if (r.className == "person" && r.config == "hog" && r.f.value)
-          report.goals.push_back({cls, "F >= 2 x HOG's F (" + shortNum(*r.f.value) + ")", 2 * *r.f.value, all->f});
+          report.goals.push_back({cls, "F >= 2 x HOG's F (" + boosting::formatMeasure(r.f.value) + ")", 2 * *r.f.value, all->f});
   }
 
   // Models on every frame (what cross-drive validation measured, trained on all of it).

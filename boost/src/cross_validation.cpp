@@ -94,6 +94,8 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
   for (const Fold& fold : folds) {
     std::string name;
     for (const auto& g : fold.testGroups) name += (name.empty() ? "" : "+") + g;
+    const std::string shortName =
+        fold.testGroups.size() > 2 ? fold.testGroups.front() + " and " + std::to_string(fold.testGroups.size() - 1) + " more drives" : name;
     std::vector<Detector> detectors;
     std::vector<CascadeSummary> parts;
     try {
@@ -109,7 +111,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
       }
     } catch (const std::runtime_error& e) {
       out.failures.push_back("fold " + name + ": " + e.what());
-      if (log) log("fold " + name + ": not trained (counted as detecting nothing): " + e.what());
+      if (log) log("fold " + shortName + ": not trained (counted as detecting nothing): " + e.what());
       for (std::size_t i : fold.test) out.frames[i] = frameOutcome({}, matchDetections({}, testItems[i].labels, match));
       continue;
     }
@@ -123,7 +125,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     if (log) {
       char line[256];
       std::snprintf(line, sizeof line, "fold %s: %zu train / %zu test items, %zu hits, %zu false alarms, %zu positives",
-                    name.c_str(), fold.train.size(), fold.test.size(), eval.counts.hits, eval.counts.falseAlarms,
+                    shortName.c_str(), fold.train.size(), fold.test.size(), eval.counts.hits, eval.counts.falseAlarms,
                     eval.counts.positives);
       log(line);
     }
