@@ -17,6 +17,7 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/core/dataset.h"
+#include "fusedet/fusion/box_drawing.h"
 #include "fusedet/fusion/camera_layers.h"
 
 namespace fusedet::tools {
@@ -157,15 +158,7 @@ int runDetect(const DetectOptions& o) {
   }
   if (!o.draw.empty()) {
     cv::Mat canvas = canvasOf(stack, bgr);
-    for (const Detection& d : dets) {
-      const cv::Rect r(int(std::lround(d.box.x)), int(std::lround(d.box.y)), int(std::lround(d.box.w)),
-                       int(std::lround(d.box.h)));
-      cv::rectangle(canvas, r, cv::Scalar(0, 0, 255), 2);
-      char label[96];
-      std::snprintf(label, sizeof label, "%s %.3g", d.className.c_str(), d.score);
-      cv::putText(canvas, label, cv::Point(r.x, std::max(12, r.y - 4)), cv::FONT_HERSHEY_SIMPLEX, 0.45,
-                  cv::Scalar(0, 0, 255), 1);
-    }
+    fusion::drawBoxes(canvas, 1.0, {}, dets);
     if (canvas.empty() || !cv::imwrite(o.draw.string(), canvas))
       throw std::runtime_error(o.draw.string() + ": cannot write image");
   }

@@ -5,6 +5,7 @@
 // OpenCV's HOG people detector as a peer; report.md, results.json and charts in the output
 // directory. The rules live in boost/ (data_split, cross_validation, bootstrap, evaluation).
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -184,11 +185,12 @@ struct Preset {
 
 Preset presetFor(const ExperimentOptions& o) {
   // Quick: a coarse pool, a few small stages, 3 drive-disjoint folds: the whole pipeline in a few
-  // minutes, for the ctest smoke run. Full: every drive is a fold (leave-one-drive-out); the
-  // training is lighter than the within-drive run's (grid 12, 20 x 100) because it is repeated
-  // for ~22 folds x 5 configurations x 3 classes on 2 shared cores.
+  // minutes, for the ctest smoke run. Full: every drive is a fold (leave-one-drive-out). Its
+  // training is much lighter than the old within-drive run's (grid 12, 20 stages x 100 stumps,
+  // 18.5 min for 15 cascades): here 22 folds x 5 configurations x 3 classes plus the learning
+  // curve are ~460 cascades, which must fit about an hour on 2 cores shared with other jobs.
   Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4, 3, 200}
-                     : Preset{8, 12, 40, 1e-5, 0, 1.25, 3, 1.1, 2, 0, 1000};
+                     : Preset{6, 8, 15, 1e-4, 300, 1.25, 3, 1.2, 3, 0, 1000};
   if (o.grid > 0) p.grid = o.grid;
   if (o.maxStages > 0) p.maxStages = o.maxStages;
   if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
@@ -437,134 +439,176 @@ int runExperiments(ExperimentOptions o) {
     for (const std::string& s : o.learning)
       if (s != "none") learning.push_back(s == "all" ? driveCount : static_cast<std::size_t>(std::stoul(s)));
   } else if (!o.quick) {
-    for (std::size_t k : {1, 2, 4, 8, 16})
-      if (k < driveCount - 1) learning.push_back(k);
+    learning = {2, 6, driveCount};  // driveCount = all training drives: the main result
   }
+  std::size_t mostDrives = 0;  // training drives of the largest fold
+  for (const auto& f : folds) mostDrives = std::max(mostDrives, boosting::trainingGroupCount(f, driveOf));
 
+  std::map<std::string, std::vector<DatasetItem>> trainItemsOf;  // layers are shared, only labels differ
   for (const std::string& cls : o.classes) {
     const boosting::MatchConfig match = boosting::matchConfigFor(cls, van);
-    std::vector<DatasetItem> trainItems = items;  // layers are shared, only labels differ
-    for (DatasetItem& item : trainItems) item.labels = boosting::trainingLabels(item.labels, match);
-    for (const std::string& config : o.configs) {
-      std::printf("%s / %s:\n", cls.c_str(), config.c_str());
-      const boosting::ChainSpec spec = chainFor(o, preset, cls, config, match);
-      const boosting::CrossValidationResult cv =
-          boosting::crossValidate(spec, trainItems, items, folds, match, setup, cache, quiet, log);
-      ConfigResult r;
-      r.className = cls;
-      r.config = config;
-      r.description = config == "and" ? "laser-only AND camera-only (a window must pass both, then grouped)"
-                                      : "layers " + joined(trainedConfig(config).layers) + "; features " +
-                                            trainedConfig(config).types;
-      r.layers = config == "and" ? std::vector<std::string>{"distance", "remission", "intensity", "hue_distance"}
-                                 : trainedConfig(config).layers;
-      r.counts = boosting::countsOf(boosting::allFrames(cv.frames));
-      const Measured mm = measure(cv.frames, boot);
-      r.f = mm.f;
-      r.ap = mm.ap;
-      r.curve = boosting::precisionRecallCurve(boosting::allFrames(cv.frames));
-      r.msPerStack = cv.msPerStack;
-      r.trainSeconds = cv.trainSeconds;
-      r.folds = folds.size();
-      r.cachedFolds = cv.cachedFolds;
-      r.failures = cv.failures;
-      if (!cv.summaries.empty()) {
-        const boosting::CascadeSummary s = boosting::combineSummaries(cv.summaries);
-        r.meanLength = static_cast<double>(s.length) / static_cast<double>(cv.summaries.size());
-        r.meanStages = static_cast<double>(s.stages) / static_cast<double>(cv.summaries.size());
-        r.layerWeightShare = s.layerWeightShare;
-        r.cornerShare = s.cornerShare();
+    trainItemsOf[cls] = items;
+    for (DatasetItem& item : trainItemsOf[cls]) item.labels = boosting::trainingLabels(item.labels, match);
+  }
+
+  // Claims, goals and charts from what is measured so far; the report is rewritten after every
+  // step, so a run stopped early still leaves a report of what it finished (marked partial).
+  const auto writeSoFar = [&](bool finished) {
+    report.claims.clear();
+    report.goals.clear();
+    for (const std::string& cls : o.classes) {
+      auto& fr = framesOf[cls];
+      const auto claim = [&](const std::string& key, const std::string& text, const std::string& a,
+                             const std::string& b) {
+        if (fr.count(a) && fr.count(b)) report.claims.push_back(compare(cls, key, text, a, fr[a], b, fr[b], boot));
+      };
+      claim("joint_gt_laser", "joint pool (all layers) > laser only", "all", "laser");
+      claim("joint_gt_camera", "joint pool (all layers) > camera only", "all", "camera");
+      claim("joint_gt_and", "joint pool (all layers) > laser AND camera", "all", "and");
+      claim("four_gt_and", "joint pool (4 layers) > laser AND camera", "four", "and");
+      claim("corners_help", "corner features help (all > all without corners)", "all", "no_corners");
+      if (cls == "person") claim("joint_gt_hog", "joint pool (all layers) > OpenCV HOG", "all", "hog");
+      std::vector<Series> pr;
+      for (const ConfigResult& r : report.results) {
+        if (r.className != cls || r.curve.empty()) continue;
+        Series se{r.config, {}, {}};
+        for (const auto& pt : r.curve) se.points.push_back({pt.recall, pt.precision});
+        pr.push_back(std::move(se));
       }
-      printLine(r);
-      report.results.push_back(r);
-      framesOf[cls][config] = cv.frames;
-      if (config == "all" && !r.layerWeightShare.empty())
-        cv::imwrite((o.out / ("weight_share_" + cls + ".png")).string(),
-                    weightShareChart(cls + ": weight share by layer (all layers, all folds)", r.layerWeightShare));
+      if (!pr.empty())
+        cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
+                    lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
+      Series lc{"F (all)", {}, {}};
+      for (const LearningPoint& p : report.learning)
+        if (p.className == cls && p.f.value) {
+          lc.points.push_back({static_cast<double>(p.drives), *p.f.value});
+          lc.band.push_back(p.f.interval ? std::make_pair(p.f.interval->lo, p.f.interval->hi)
+                                         : std::make_pair(*p.f.value, *p.f.value));
+        }
+      if (!lc.points.empty())
+        cv::imwrite((o.out / ("learning_" + cls + ".png")).string(),
+                    lineChart(cls + ": F vs training drives per fold (95% CI)", "training drives", "F",
+                              static_cast<double>(mostDrives), {lc}));
     }
-    // Learning curve of the joint pool.
-    if (!learning.empty() && std::find(o.configs.begin(), o.configs.end(), "all") != o.configs.end()) {
+    const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
+    for (const ConfigResult& all : report.results) {
+      if (all.config != "all" || !targets.count(all.className)) continue;
+      report.goals.push_back({all.className, "F >= " + shortNum(targets.at(all.className)), targets.at(all.className),
+                              all.f});
+      if (all.className == "person")
+        for (const ConfigResult& r : report.results)
+          if (r.className == "person" && r.config == "hog" && r.f.value)
+            report.goals.push_back(
+                {"person", "F >= 2 x HOG's F (" + boosting::formatMeasure(r.f.value) + ")", 2 * *r.f.value, all.f});
+    }
+    report.notes.erase(std::remove_if(report.notes.begin(), report.notes.end(),
+                                      [](const std::string& n) { return n.rfind("PARTIAL", 0) == 0; }),
+                       report.notes.end());
+    if (!finished)
+      report.notes.insert(report.notes.begin(),
+                          "PARTIAL: written while the run was still going; configurations or learning-curve points "
+                          "missing here were not finished.");
+    report.totalSeconds = std::chrono::duration<double>(Clock::now() - tStart).count();
+    report.loadAverage = loadAverage();
+    writeReport(o.out, report);
+  };
+
+  const auto runConfig = [&](const std::string& cls, const std::string& config) {
+    const boosting::MatchConfig match = boosting::matchConfigFor(cls, van);
+    std::printf("%s / %s:\n", cls.c_str(), config.c_str());
+    const boosting::ChainSpec spec = chainFor(o, preset, cls, config, match);
+    const boosting::CrossValidationResult cv =
+        boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, setup, cache, quiet, log);
+    ConfigResult r;
+    r.className = cls;
+    r.config = config;
+    r.description = config == "and" ? "laser-only AND camera-only (a window must pass both, then grouped)"
+                                    : "layers " + joined(trainedConfig(config).layers) + "; features " +
+                                          trainedConfig(config).types;
+    r.layers = config == "and" ? std::vector<std::string>{"distance", "remission", "intensity", "hue_distance"}
+                               : trainedConfig(config).layers;
+    r.counts = boosting::countsOf(boosting::allFrames(cv.frames));
+    const Measured mm = measure(cv.frames, boot);
+    r.f = mm.f;
+    r.ap = mm.ap;
+    r.curve = boosting::precisionRecallCurve(boosting::allFrames(cv.frames));
+    r.msPerStack = cv.msPerStack;
+    r.trainSeconds = cv.trainSeconds;
+    r.folds = folds.size();
+    r.cachedFolds = cv.cachedFolds;
+    r.failures = cv.failures;
+    if (!cv.summaries.empty()) {
+      const boosting::CascadeSummary sum = boosting::combineSummaries(cv.summaries);
+      r.meanLength = static_cast<double>(sum.length) / static_cast<double>(cv.summaries.size());
+      r.meanStages = static_cast<double>(sum.stages) / static_cast<double>(cv.summaries.size());
+      r.layerWeightShare = sum.layerWeightShare;
+      r.cornerShare = sum.cornerShare();
+    }
+    printLine(r);
+    // Keep the table order of --configs whatever order the phases ran in.
+    const auto rank = [&](const ConfigResult& x) {
+      const auto it = std::find(o.configs.begin(), o.configs.end(), x.config);
+      return std::make_pair(std::find(o.classes.begin(), o.classes.end(), x.className) - o.classes.begin(),
+                            x.trained ? it - o.configs.begin() : -1);
+    };
+    report.results.push_back(r);
+    std::stable_sort(report.results.begin(), report.results.end(),
+                     [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
+    framesOf[cls][config] = cv.frames;
+    if (config == "all" && !r.layerWeightShare.empty())
+      cv::imwrite((o.out / ("weight_share_" + cls + ".png")).string(),
+                  weightShareChart(cls + ": weight share by layer (all layers, all folds)", r.layerWeightShare));
+  };
+
+  // Phase 1, the headline: the joint pool of every class. Phase 2: the paper's other
+  // configurations (the claims). Phase 3: learning curves.
+  const bool wantAll = std::find(o.configs.begin(), o.configs.end(), "all") != o.configs.end();
+  if (wantAll)
+    for (const std::string& cls : o.classes) {
+      runConfig(cls, "all");
+      writeSoFar(false);
+    }
+  for (const std::string& config : o.configs) {
+    if (config == "all") continue;
+    for (const std::string& cls : o.classes) {
+      runConfig(cls, config);
+      writeSoFar(false);
+    }
+  }
+  if (wantAll)
+    for (const std::string& cls : o.classes) {
+      const boosting::MatchConfig match = boosting::matchConfigFor(cls, van);
       const boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
       for (std::size_t k : learning) {
         LearningPoint p;
         p.className = cls;
-        p.drives = k;
+        p.drives = std::min(k, mostDrives);
         std::vector<boosting::FrameOutcome> frames;
-        if (k >= driveCount - 1) {
+        if (k >= mostDrives) {
           frames = framesOf[cls]["all"];
         } else {
           std::vector<boosting::Fold> sub;
           for (const auto& f : folds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
           std::printf("%s / all, %zu training drives per fold:\n", cls.c_str(), k);
-          frames = boosting::crossValidate(spec, trainItems, items, sub, match, setup, cache, quiet, log).frames;
+          frames = boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log).frames;
         }
         p.counts = boosting::countsOf(boosting::allFrames(frames));
         const Measured mm = measure(frames, boot);
         p.f = mm.f;
         p.ap = mm.ap;
-        std::printf("%-7s learning curve: %2zu drives  F %s  AP %s\n", cls.c_str(), k, formatEstimate(p.f).c_str(),
-                    formatEstimate(p.ap).c_str());
+        std::printf("%-7s learning curve: %2zu drives  F %s  AP %s\n", cls.c_str(), p.drives,
+                    formatEstimate(p.f).c_str(), formatEstimate(p.ap).c_str());
         report.learning.push_back(p);
+        writeSoFar(false);
       }
     }
-    // Charts of this class.
-    std::vector<Series> pr;
-    for (const ConfigResult& r : report.results) {
-      if (r.className != cls || r.curve.empty()) continue;
-      Series s{r.config, {}, {}};
-      for (const auto& pt : r.curve) s.points.push_back({pt.recall, pt.precision});
-      pr.push_back(std::move(s));
-    }
-    cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
-                lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
-    Series lc{"F (all)", {}, {}};
-    for (const LearningPoint& p : report.learning)
-      if (p.className == cls && p.f.value) {
-        lc.points.push_back({static_cast<double>(p.drives), *p.f.value});
-        lc.band.push_back(p.f.interval ? std::make_pair(p.f.interval->lo, p.f.interval->hi)
-                                       : std::make_pair(*p.f.value, *p.f.value));
-      }
-    if (!lc.points.empty())
-      cv::imwrite((o.out / ("learning_" + cls + ".png")).string(),
-                  lineChart(cls + ": F vs training drives per fold (95% CI)", "training drives", "F",
-                            static_cast<double>(driveCount), {lc}));
-    // The paper's claims on this class.
-    auto& fr = framesOf[cls];
-    const auto claim = [&](const std::string& key, const std::string& text, const std::string& a,
-                           const std::string& b) {
-      if (fr.count(a) && fr.count(b)) report.claims.push_back(compare(cls, key, text, a, fr[a], b, fr[b], boot));
-    };
-    claim("joint_gt_laser", "joint pool (all layers) > laser only", "all", "laser");
-    claim("joint_gt_camera", "joint pool (all layers) > camera only", "all", "camera");
-    claim("joint_gt_and", "joint pool (all layers) > laser AND camera", "all", "and");
-    claim("four_gt_and", "joint pool (4 layers) > laser AND camera", "four", "and");
-    claim("corners_help", "corner features help (all > all without corners)", "all", "no_corners");
-    if (cls == "person") claim("joint_gt_hog", "joint pool (all layers) > OpenCV HOG", "all", "hog");
-  }
-
-  // The goals on the joint pool.
-  const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
-  for (const std::string& cls : o.classes) {
-    const auto* all = [&]() -> const ConfigResult* {
-      for (const ConfigResult& r : report.results)
-        if (r.className == cls && r.config == "all") return &r;
-      return nullptr;
-    }();
-    if (!all || !targets.count(cls)) continue;
-    report.goals.push_back({cls, "F >= " + shortNum(targets.at(cls)), targets.at(cls), all->f});
-    if (cls == "person")
-      for (const ConfigResult& r : report.results)
-        if (r.className == "person" && r.config == "hog" && r.f.value)
-          report.goals.push_back({cls, "F >= 2 x HOG's F (" + boosting::formatMeasure(r.f.value) + ")", 2 * *r.f.value, all->f});
-  }
 
   // Models on every frame (what cross-drive validation measured, trained on all of it).
   if (!o.modelsOut.empty()) {
     fs::create_directories(o.modelsOut);
     for (const std::string& cls : o.classes) {
       const boosting::MatchConfig match = boosting::matchConfigFor(cls, van);
-      std::vector<DatasetItem> trainItems = items;
-      for (DatasetItem& item : trainItems) item.labels = boosting::trainingLabels(item.labels, match);
+      const std::vector<DatasetItem>& trainItems = trainItemsOf[cls];
       std::vector<std::size_t> every(items.size());
       for (std::size_t i = 0; i < every.size(); ++i) every[i] = i;
       const boosting::TrainingConfig config = trainingConfig(o, preset, cls, trainedConfig("all"), match);
@@ -581,9 +625,7 @@ int runExperiments(ExperimentOptions o) {
     }
   }
 
-  report.totalSeconds = std::chrono::duration<double>(Clock::now() - tStart).count();
-  report.loadAverage = loadAverage();
-  writeReport(o.out, report);
+  writeSoFar(true);
   std::printf("\nwrote %s and %s (%.1f min)\n", (o.out / "report.md").c_str(), (o.out / "results.json").c_str(),
               report.totalSeconds / 60);
   return 0;
@@ -638,7 +680,7 @@ const bool registered = registerCommand(
                o->learningSet = true;
              },
              "training drives per fold for the learning curve of `all`, e.g. 1,2,4,8,all; none = no curve "
-             "(default: 1,2,4,8,16 and all drives; quick: none)")
+             "(default: 2,6,all; quick: none)")
           ->delimiter(',');
       app.add_option("--bootstrap", o->resamples, "bootstrap resamples of the frames (default: 1000, quick 200)");
       app.add_option("--seed", o->seed, "training and bootstrap seed (same seed + data = same numbers)")
@@ -650,13 +692,13 @@ const bool registered = registerCommand(
                      "enlarge images by this factor for HOG, whose 64x128 window exceeds many KITTI pedestrians "
                      "(default: 2, quick 1)")
           ->check(CLI::Range(0.5, 4.0));
-      app.add_option("--grid", o->grid, "feature pool grid, units per side (default: 8, quick 6)");
-      app.add_option("--max-stages", o->maxStages, "stage limit (default: 12, quick 4)");
-      app.add_option("--max-weak", o->maxWeak, "stumps per stage at most (default: 40, quick 5)");
-      app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-5, quick 1e-3)");
-      app.add_option("--negatives", o->negatives, "negatives per stage (default: max(500, 2 x positives), quick 200)");
-      app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.1, quick 1.3)");
-      app.add_option("--step", o->step, "detection position step in base-window pixels (default: 2, quick 4)");
+      app.add_option("--grid", o->grid, "feature pool grid, units per side (default: 6)");
+      app.add_option("--max-stages", o->maxStages, "stage limit (default: 8, quick 4)");
+      app.add_option("--max-weak", o->maxWeak, "stumps per stage at most (default: 15, quick 5)");
+      app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-4, quick 1e-3)");
+      app.add_option("--negatives", o->negatives, "negatives per stage (default: 300, quick 200)");
+      app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.2, quick 1.3)");
+      app.add_option("--step", o->step, "detection position step in base-window pixels (default: 3, quick 4)");
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
       app.add_option("--min-positives", o->minPositives,
                      "training ends when fewer positives than this are still accepted (person data is scarce)")
