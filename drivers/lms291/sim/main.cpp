@@ -3,6 +3,7 @@
 // --duration, then prints its counters as one JSON line.
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <ctime>
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   double resolution = 0.5;
   std::vector<double> post;
   std::string status = "0x10";
+  std::string logPath;
 
   CLI::App app{
       "lms291-sim - a SICK LMS 291 laser scanner on a pseudo-terminal.\n"
@@ -44,6 +46,10 @@ int main(int argc, char** argv) {
   app.add_option("--room-half-width", o.scene.halfWidth, "side walls at x = +-W [m]")->capture_default_str();
   app.add_option("--room-depth", o.scene.depth, "front wall at y = D [m]")->capture_default_str();
   app.add_option("--post", post, "replace the posts by one at X Y RADIUS [m] (default 0.5 2.0 0.2)")->expected(3);
+  app.add_option("--log", logPath,
+                 "stream the laser scans of this sensor log (fusedet synth-log / fusedet record) instead of the room, "
+                 "in order, one per scan, looping at the end; the device powers on in the log's variant and refuses "
+                 "a host that asks for another variant or range unit (no resampling)");
   app.add_flag("--trace", o.trace, "log host reads (with the host's speed) and device speed changes to stderr");
   app.add_flag("--counter-beam", o.counterBeam, "beam 0 carries the sent-scan counter: 1000 + n mod 4000 (code units)");
   app.add_option("--flip-rate", o.faults.bitFlipRate, "probability per output byte of one flipped bit")->capture_default_str();
@@ -63,9 +69,10 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  lms291-sim --link /tmp/lms &                    # then: fusedet lms stream /tmp/lms\n"
       "  lms291-sim --link /tmp/lms --flip-rate 0.01     # 1 % corrupted bytes\n"
+      "  fusedet synth-log --out /tmp/s.mcap && lms291-sim --link /tmp/lms --log /tmp/s.mcap   # the log's scans\n"
       "  lms291-sim --link /tmp/lms --vanish-every 5 --vanish-for 1\n"
       "  socat pty,raw,link=/tmp/a pty,raw,link=/tmp/b & lms291-sim --attach /tmp/a   # host opens /tmp/b\n"
-      "Exit status: 0 after a clean stop, 1 on bad options or when the pty cannot be created.");
+      "Exit status: 0 after a clean stop, 1 on bad options, an unreadable --log or when the pty cannot be created.");
   CLI11_PARSE(app, argc, argv);
   if (o.link.empty() && o.attach.empty()) {
     std::cerr << "lms291-sim: error: give --link PATH (new pty) or --attach TTY\n";
@@ -82,6 +89,23 @@ int main(int argc, char** argv) {
   } catch (const std::exception&) {
     std::cerr << "lms291-sim: error: --status " << status << " is not a number\n";
     return 1;
+  }
+  if (!logPath.empty()) {
+    auto scans = sim::loadLoggedScans(logPath);
+    if (!scans) {
+      std::cerr << "lms291-sim: error: --log: " << scans.error().message() << "\n";
+      return 1;
+    }
+    o.variant = scans->variant;
+    o.log = std::make_shared<const sim::LoggedScans>(std::move(*scans));
+    std::vector<float> first;
+    for (float r : o.log->scans.front().ranges)
+      if (r > 0) first.push_back(r);
+    std::sort(first.begin(), first.end());
+    std::printf("lms291-sim: log %s: %zu scans, %d deg / %.2f deg, %s, %s; first scan median range %.2f m\n", logPath.c_str(),
+                o.log->scans.size(), o.variant.angleDeg, o.variant.resolutionCdeg / 100.0,
+                o.log->unit == Unit::kMm ? "mm" : "cm", o.log->remission ? "range + remission" : "range only",
+                first.empty() ? 0.0 : first[first.size() / 2]);
   }
   if (post.size() == 3) o.scene.posts = {sim::Post{post[0], post[1], post[2]}};
 

@@ -227,9 +227,36 @@ std::uint16_t Simulator::encodeRange(double meters) const {
   return static_cast<std::uint16_t>(code);
 }
 
+// With --log, only the log's own scan mode is served: resampling would invent ranges.
+bool Simulator::logRefuses(std::optional<Variant> v, std::optional<Unit> unit) const {
+  if (!options_.log) return false;
+  const LoggedScans& l = *options_.log;
+  const auto cdeg = [](const Variant& x) { return std::to_string(x.angleDeg) + " deg / " + std::to_string(x.resolutionCdeg) + " cdeg"; };
+  const auto name = [](Unit u) { return std::string(u == Unit::kMm ? "mm" : "cm"); };
+  std::string asked, held;
+  if (v && *v != l.variant) asked = cdeg(*v), held = cdeg(l.variant);
+  if (unit && *unit != l.unit) asked = "range unit " + name(*unit), held = "range unit " + name(l.unit);
+  if (asked.empty()) return false;
+  std::fprintf(stderr, "lms291-sim: error: the host asked for %s, the log holds %s: refused (configure the driver like the log's rig)\n",
+               asked.c_str(), held.c_str());
+  return true;
+}
+
 std::vector<std::uint16_t> Simulator::scanValues(int rotation, int rotations, std::vector<std::uint16_t>* remission) {
   std::vector<std::uint16_t> values;
   const int n = variant_.beams();
+  if (options_.log) {  // the logged scan, re-encoded in the device's current unit
+    const LaserScan& s = options_.log->scans[logScan_ % options_.log->scans.size()];
+    for (int i = rotation; i < n; i += rotations) {
+      const auto k = static_cast<std::size_t>(i);
+      const double r = k < s.ranges.size() && s.ranges[k] > 0 ? s.ranges[k] : 0.0;  // 0 / NaN: no return
+      values.push_back(encodeRange(r));
+      if (remission)
+        remission->push_back(k < s.remissions.size() ? static_cast<std::uint16_t>(std::lround(std::clamp(s.remissions[k], 0.0f, 65535.0f))) : 0);
+    }
+    if (rotation + 1 >= rotations) ++logScan_;  // interlaced: after the scan's last part
+    return values;
+  }
   for (int i = rotation; i < n; i += rotations) {
     const double deg = variant_.startDeg() + i * variant_.resolutionCdeg / 100.0;
     const Hit h = scene_.cast(deg * M_PI / 180.0);
@@ -352,7 +379,7 @@ void Simulator::handleRequest(const Telegram& t, Clock::time_point now) {
       if (fast) return reply(kUnknownCommandReply, {}, at);
       if (d.size() != 4) return reply(kUnknownCommandReply, {}, at);
       const Variant v{u16(d, 0), u16(d, 2)};
-      const bool ok = v.valid();
+      const bool ok = v.valid() && !logRefuses(v, std::nullopt);
       if (ok) variant_ = v;
       std::vector<std::uint8_t> out{static_cast<std::uint8_t>(ok ? 1 : 0)};
       putU16(out, static_cast<std::uint16_t>(variant_.angleDeg));
@@ -361,7 +388,7 @@ void Simulator::handleRequest(const Telegram& t, Clock::time_point now) {
     }
     case Command::kReadConfig: return reply(r, config_, at);
     case Command::kWriteConfig: {
-      const bool ok = mode_ == 0x00 && (d.size() == kConfigSize || d.size() == 32);
+      const bool ok = mode_ == 0x00 && (d.size() == kConfigSize || d.size() == 32) && !logRefuses(std::nullopt, d[6] == 1 ? Unit::kMm : Unit::kCm);
       if (ok) std::copy(d.begin(), d.end(), config_.begin());
       std::vector<std::uint8_t> out{static_cast<std::uint8_t>(ok ? 1 : 0)};
       out.insert(out.end(), config_.begin(), config_.end());

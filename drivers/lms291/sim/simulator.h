@@ -23,7 +23,9 @@
 #include <chrono>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -33,6 +35,7 @@
 #include "fusedet/drivers/lms291/protocol.h"
 #include "fusedet/drivers/lms291/telegram.h"
 #include "fusedet/drivers/unique_fd.h"
+#include "log_scans.h"
 #include "scene.h"
 
 namespace fusedet::drivers::lms291::sim {
@@ -58,6 +61,11 @@ struct SimOptions {
   Variant variant{180, 50};            // at power-on
   std::uint8_t status = 0x10;          // status byte of normal replies
   SceneOptions scene;
+  // Instead of the room: these scans, one per scan in order, looping at the end (lms291-sim
+  // --log). The device then accepts only the log's variant and range unit: a host asking for
+  // another is refused (variant 0x3B / configuration 0x77 answered "not accepted", reason on
+  // stderr), no resampling. A host asking for remission from a log without it gets 0 remissions.
+  std::shared_ptr<const LoggedScans> log;
   bool counterBeam = false;            // beam 0 carries the sent-scan counter: 1 m + n mm (n mod 4000)
   Faults faults;
   std::uint64_t seed = 1;
@@ -148,6 +156,7 @@ class Simulator {
   void queueScan(Clock::time_point now);
   std::vector<std::uint16_t> scanValues(int rotation, int rotations, std::vector<std::uint16_t>* remission);
   std::uint16_t encodeRange(double meters) const;
+  bool logRefuses(std::optional<Variant> v, std::optional<Unit> unit) const;
   void pumpOutput(Clock::time_point now);
   Clock::duration lineTime(std::size_t bytes) const;
   int hostBaud() const;
@@ -182,6 +191,7 @@ class Simulator {
   Clock::time_point reappearAt_;
   std::chrono::milliseconds vanishRequest_{-1};
   std::uint64_t scansQueued_ = 0;
+  std::uint64_t logScan_ = 0;  // with options_.log: index of the next logged scan (mod size)
   bool present_ = false;
   SimCounters counters_;
   std::vector<std::uint64_t> damagedScans_;
