@@ -1,7 +1,7 @@
 // fusedet usb: USB devices through libusb.
-//   list [VID:PID[:SERIAL]]   devices with their sysfs position, strings and /dev nodes
-//   reset VID:PID[:SERIAL]    reset the one matching device (it re-enumerates)
-//   watch [VID:PID[:SERIAL]]  print hotplug arrivals and departures
+//   list [VID:PID[:SERIAL][@PORT]]   devices with their sysfs position, strings and /dev nodes
+//   reset VID:PID[:SERIAL][@PORT]    reset the one matching device (it re-enumerates)
+//   watch [VID:PID[:SERIAL][@PORT]]  print hotplug arrivals and departures
 
 #include <atomic>
 #include <csignal>
@@ -134,14 +134,14 @@ const bool registered = registerCommand(
     [](CLI::App& app) {
       auto o = std::make_shared<UsbOptions>();
       app.require_subcommand(1);
-      CLI::App* list = app.add_subcommand("list", "list USB devices (all, or those matching VID:PID[:SERIAL]) with their /dev nodes");
-      list->add_option("MATCH", o->match, "VID:PID[:SERIAL] in hex, e.g. 0403:6001");
+      CLI::App* list = app.add_subcommand("list", "list USB devices (all, or those matching VID:PID[:SERIAL][@PORT]) with their /dev nodes");
+      list->add_option("MATCH", o->match, "VID:PID[:SERIAL][@PORT] in hex, e.g. 0403:6001 or 0403:6001@1-2 (PORT as in /sys/bus/usb/devices)");
       list->add_flag("--json", o->json, "a JSON array: id, vendor, product, bus, address, port, serial, manufacturer, product_name, nodes[]");
-      CLI::App* reset = app.add_subcommand("reset", "reset the one device matching VID:PID[:SERIAL] (USBDEVFS_RESET; it re-enumerates)");
-      reset->add_option("MATCH", o->match, "VID:PID[:SERIAL] in hex")->required();
+      CLI::App* reset = app.add_subcommand("reset", "reset the one device matching VID:PID[:SERIAL][@PORT] (USBDEVFS_RESET; it re-enumerates)");
+      reset->add_option("MATCH", o->match, "VID:PID[:SERIAL][@PORT] in hex")->required();
       reset->add_flag("--json", o->json, "print {\"reset\": device} (or the error object)");
       CLI::App* watch = app.add_subcommand("watch", "print hotplug arrivals (devices present first) and departures until --duration/--count/Ctrl-C");
-      watch->add_option("MATCH", o->match, "VID:PID[:SERIAL] in hex (default: every device)");
+      watch->add_option("MATCH", o->match, "VID:PID[:SERIAL][@PORT] in hex (default: every device)");
       watch->add_option("--duration", o->duration, "stop after S seconds (0 = no limit)")->capture_default_str();
       watch->add_option("--count", o->count, "stop after N events (0 = no limit)")->capture_default_str();
       watch->add_flag("--json", o->json, "one JSON object per event: the list fields plus event (arrived|left)");

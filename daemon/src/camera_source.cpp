@@ -3,14 +3,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <spdlog/spdlog.h>
+
+#include "fusedet/drivers/usb/usb_devices.h"
 #include "fusedet/drivers/v4l2/controls.h"
 #include "fusedet/drivers/v4l2/negotiation.h"
 
 namespace fusedet::daemon {
 
 drivers::v4l2::CameraConfig cameraConfigFrom(const Config::Camera& camera) {
-  if (!camera.usb.empty())
-    throw std::runtime_error("camera.usb: fusedetd opens cameras by camera.device only; set it to the node (or a udev symlink)");
   drivers::v4l2::CameraConfig c;
   c.device = camera.device;
   const auto format = drivers::v4l2::parseFormatChoice(camera.format);
@@ -37,18 +38,47 @@ drivers::v4l2::FrameStreamTiming cameraTimingFrom(const Config::Camera& camera) 
   return t;
 }
 
-CameraSource::CameraSource(const Config::Camera& camera)
-    : config_(cameraConfigFrom(camera)), timing_(cameraTimingFrom(camera)) {}
+namespace {
+
+std::optional<drivers::usb::UsbMatch> usbMatchFrom(const Config::Camera& camera) {
+  if (camera.usb.empty()) return std::nullopt;
+  auto m = drivers::usb::parseUsbMatch(camera.usb);
+  if (!m) throw std::runtime_error("camera.usb: " + m.error().context);
+  return *m;
+}
+
+}  // namespace
+
+CameraSource::CameraSource(const Config::Camera& camera, drivers::usb::UsbSysfs sysfs)
+    : config_(cameraConfigFrom(camera)), timing_(cameraTimingFrom(camera)), usb_(usbMatchFrom(camera)),
+      sysfs_(std::move(sysfs)) {}
 
 CameraSource::~CameraSource() { stop(); }
 
 void CameraSource::start(SensorSink& sink) {
   stream_ = std::make_unique<drivers::v4l2::FrameStream>(
       config_, [&sink](const drivers::CameraFrame& frame) { sink.onFrame(frame); }, timing_);
+  if (usb_) {
+    // sysfs alone: it needs no usbfs, which the service's device sandbox does not grant.
+    stream_->setDeviceResolver([match = *usb_, sysfs = sysfs_] { return drivers::usb::resolveNodeFromSysfs(sysfs, match, "video"); });
+    auto* stream = stream_.get();
+    auto hotplug = drivers::usb::UsbHotplug::start(
+        *usb_,
+        [stream](drivers::usb::HotplugEvent event, const drivers::usb::UsbDeviceInfo&) {
+          if (event == drivers::usb::HotplugEvent::kArrived) stream->deviceArrived();
+        },
+        sysfs_);
+    if (hotplug)
+      hotplug_ = std::move(*hotplug);
+    else
+      spdlog::info("camera.usb {}: no USB hotplug events ({}); the device is looked up every 100 ms while absent",
+                   usb_->toString(), hotplug.error().message());
+  }
   stream_->start();
 }
 
 void CameraSource::stop() {
+  if (hotplug_) hotplug_->stop();  // its callback pokes stream_
   if (stream_) stream_->stop();
 }
 

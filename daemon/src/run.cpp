@@ -78,6 +78,7 @@ int runDaemon(const RunOptions& options) {
   const auto maxAgeNs = static_cast<std::int64_t>(watchdogUs ? watchdogUs * 500 : 5'000'000'000ULL);
   const int tickMs = watchdogUs ? static_cast<int>(std::max<std::uint64_t>(50, std::min<std::uint64_t>(watchdogUs / 4000, 1000))) : 1000;
   std::string shown = service->summary();
+  bool wasAlive = true;
   notify("READY=1\nSTATUS=" + shown);
   spdlog::info("ready: {}", shown);
 
@@ -102,14 +103,22 @@ int runDaemon(const RunOptions& options) {
         }
       }
     }
-    if (watchdogUs && service->alive(maxAgeNs)) notify("WATCHDOG=1");
+    // A stuck thread withholds WATCHDOG=1 (systemd restarts the service after WatchdogSec) and
+    // is named in STATUS= and the log meanwhile; pings resume if it recovers first.
+    const std::string stuck = service->stalled(maxAgeNs);
+    if (watchdogUs && stuck.empty()) notify("WATCHDOG=1");
+    if (stuck.empty() != wasAlive) {
+      wasAlive = stuck.empty();
+      if (wasAlive) spdlog::info("watchdog: every pipeline thread shows life again");
+      else spdlog::warn("watchdog: {}{}", stuck, watchdogUs ? "; WATCHDOG=1 withheld" : "");
+    }
     if (exitAtEnd && service->finished()) {
       spdlog::info("end of the replayed log: flushing clients and stopping");
       notify("STOPPING=1\nSTATUS=replay finished");
       service->stop(Clock::now() + kShutdownBudget);
       return 0;
     }
-    if (std::string now = service->summary(); now != shown) {
+    if (std::string now = service->summary() + (stuck.empty() ? "" : "; " + stuck); now != shown) {
       shown = std::move(now);
       notify("STATUS=" + shown);
     }

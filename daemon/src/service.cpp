@@ -186,10 +186,21 @@ bool Service::finished() const {
   return pipeline_->idle();
 }
 
-bool Service::alive(std::int64_t maxAgeNs) const {
+bool Service::alive(std::int64_t maxAgeNs) const { return stalled(maxAgeNs).empty(); }
+
+std::string Service::stalled(std::int64_t maxAgeNs) const {
   const std::int64_t now = Stamp::now().ns;
-  return now - pipeline_->fusionBeatNs() < maxAgeNs && now - pipeline_->detectionBeatNs() < maxAgeNs &&
-         now - server_->beatNs() < maxAgeNs;
+  std::string out;
+  for (const auto& [name, beat] : {std::pair{"fusion", pipeline_->fusionBeatNs()},
+                                   std::pair{"detection", pipeline_->detectionBeatNs()},
+                                   std::pair{"server", server_->beatNs()}}) {
+    const std::int64_t age = now - beat;
+    if (age < maxAgeNs) continue;
+    const std::int64_t seconds = age / 1'000'000'000;
+    out += (out.empty() ? "" : ", ") + std::string(name) + " thread stuck for " +
+           (seconds ? std::to_string(seconds) : std::string("<1")) + " s";
+  }
+  return out;
 }
 
 std::string Service::summary() const {

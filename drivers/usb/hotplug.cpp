@@ -45,7 +45,7 @@ void UsbHotplug::handle(void* device, int event) {
   if (event == LIBUSB_HOTPLUG_EVENT_DEVICE_ARRIVED) {
     auto info = describeDevice(dev, sysfs_, /*mayOpen=*/false);
     if (!info) return;
-    if (match_ && !match_->matches(info->vendor, info->product, info->serial)) return;
+    if (match_ && !(match_->matches(info->vendor, info->product, info->serial) && match_->atPort(info->name))) return;
     present_[key] = *info;
     callback_(HotplugEvent::kArrived, *info);
     return;

@@ -17,14 +17,14 @@ std::string libusbErrorText(int code) {
 Result<UsbDeviceInfo> selectOne(const std::vector<UsbDeviceInfo>& devices, const UsbMatch& match) {
   std::vector<const UsbDeviceInfo*> hits;
   for (const UsbDeviceInfo& d : devices)
-    if (match.matches(d.vendor, d.product, d.serial)) hits.push_back(&d);
+    if (match.matches(d.vendor, d.product, d.serial) && match.atPort(d.name)) hits.push_back(&d);
   if (hits.empty()) return makeError(std::errc::no_such_device, "usb " + match.toString() + ": no such device connected");
   if (hits.size() > 1) {
     std::string which;
     for (const UsbDeviceInfo* d : hits)
       which += (which.empty() ? "" : ", ") + d->name + (d->serial ? " serial " + *d->serial : " (no serial)");
     return makeError(std::errc::invalid_argument, "usb " + match.toString() + ": " + std::to_string(hits.size()) +
-                                                      " devices match (" + which + "); add the serial: VID:PID:SERIAL");
+                                                      " devices match (" + which + "); add the serial (VID:PID:SERIAL) or the port (VID:PID@PORT)");
   }
   return *hits.front();
 }
@@ -55,7 +55,7 @@ Result<std::vector<UsbDeviceInfo>> UsbBus::list(const std::optional<UsbMatch>& m
   for (ssize_t i = 0; i < n; ++i) {
     auto info = describeDevice(devices[i], sysfs_);
     if (!info) continue;  // a descriptor that cannot be read: the device is going away
-    if (match && !match->matches(info->vendor, info->product, info->serial)) continue;
+    if (match && !(match->matches(info->vendor, info->product, info->serial) && match->atPort(info->name))) continue;
     out.push_back(std::move(*info));
   }
   libusb_free_device_list(devices, 1);

@@ -19,6 +19,24 @@ std::optional<std::uint16_t> parseHex16(std::string_view s) {
   return v;
 }
 
+// BUS-PORT[.PORT...], all decimal: "1-2", "3-1.4.2".
+bool isPortName(std::string_view s) {
+  const auto dash = s.find('-');
+  if (dash == 0 || dash == std::string_view::npos || dash + 1 == s.size()) return false;
+  char prev = '-';
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const char c = s[i];
+    if (i == dash) continue;
+    if (c == '.' && i > dash && prev != '.' && prev != '-' && i + 1 < s.size()) {
+      prev = c;
+      continue;
+    }
+    if (c < '0' || c > '9') return false;
+    prev = c;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string hex4(std::uint16_t v) {
@@ -33,14 +51,28 @@ bool UsbMatch::matches(std::uint16_t vid, std::uint16_t pid, const std::optional
 }
 
 std::string UsbMatch::toString() const {
-  return hex4(vendor) + ":" + hex4(product) + (serial ? ":" + *serial : "");
+  return hex4(vendor) + ":" + hex4(product) + (serial ? ":" + *serial : "") + (port ? "@" + *port : "");
 }
 
-Result<UsbMatch> parseUsbMatch(std::string_view text) {
+Result<UsbMatch> parseUsbMatch(std::string_view whole) {
   const auto bad = [&](const std::string& why) {
     return makeError(std::errc::invalid_argument,
-                     "USB device '" + std::string(text) + "': " + why + " (expected VID:PID[:SERIAL], VID and PID in hex, e.g. 0403:6001)");
+                     "USB device '" + std::string(whole) + "': " + why + " (expected VID:PID[:SERIAL][@PORT], VID and PID in hex, e.g. 0403:6001 or 046d:0825@1-2.3)");
   };
+  // "@PORT" at the end names the port; an '@' inside a serial stays part of it unless what follows
+  // it is a port name.
+  std::string_view text = whole;
+  std::optional<std::string> port;
+  if (const auto at = whole.rfind('@'); at != std::string_view::npos) {
+    const std::string_view tail = whole.substr(at + 1);
+    const bool hasSerial = whole.substr(0, at).find(':') != whole.substr(0, at).rfind(':');
+    if (isPortName(tail)) {
+      port = std::string(tail);
+      text = whole.substr(0, at);
+    } else if (!hasSerial) {
+      return bad("port '" + std::string(tail) + "' is not BUS-PORT[.PORT...] as in /sys/bus/usb/devices (e.g. 1-2.3)");
+    }
+  }
   const auto c1 = text.find(':');
   if (c1 == std::string_view::npos) return bad("no ':' between vendor and product id");
   const auto c2 = text.find(':', c1 + 1);
@@ -60,6 +92,7 @@ Result<UsbMatch> parseUsbMatch(std::string_view text) {
       if (static_cast<unsigned char>(c) < 0x21 || static_cast<unsigned char>(c) > 0x7E) return bad("the serial has a space or control character");
     m.serial = std::string(serial);
   }
+  m.port = std::move(port);
   return m;
 }
 

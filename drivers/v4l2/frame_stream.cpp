@@ -56,6 +56,25 @@ bool FrameStream::waitForDevice() {
   return running_.load();
 }
 
+bool FrameStream::resolveDevice() {
+  auto node = resolver_();
+  if (!node) {
+    bool changed;
+    {
+      std::lock_guard lock(mutex_);
+      changed = counters_.lastError != node.error().message();
+    }
+    if (changed) spdlog::warn("camera: {}; looking again every {} ms", node.error().message(), kResolvePoll.count());
+    noteError(node.error());
+    return false;
+  }
+  if (*node != camera_.config().device) {
+    spdlog::info("camera: device node {}", *node);
+    camera_.setDevice(*node);
+  }
+  return true;
+}
+
 void FrameStream::noteError(const Error& e) {
   std::lock_guard lock(mutex_);
   counters_.lastError = e.message();
@@ -114,6 +133,11 @@ void FrameStream::run() {
   bool everStarted = false;
   while (running_) {
     state_ = StreamState::kConnecting;
+    if (resolver_ && !resolveDevice()) {
+      state_ = StreamState::kBackingOff;
+      if (!sleepFor(kResolvePoll)) break;
+      continue;
+    }
     auto info = camera_.start();
     if (!info) {
       {
@@ -126,7 +150,7 @@ void FrameStream::run() {
       if (code == std::errc::no_such_file_or_directory) {
         // The node is gone (camera unplugged): a stat is cheap, so watch for it briskly.
         spdlog::debug("{}; waiting for the device to reappear", info.error().message());
-        if (!waitForDevice()) break;
+        if (resolver_ ? !sleepFor(kResolvePoll) : !waitForDevice()) break;
         continue;
       }
       spdlog::warn("{}; retrying in {} ms", info.error().message(), backoff.count());

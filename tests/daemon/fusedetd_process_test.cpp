@@ -340,3 +340,61 @@ TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
       << readFile(dir / "log2");
   EXPECT_FALSE(fs::exists(dir / "b.sock"));
 }
+
+namespace {
+// A cascade far too slow for the machine: 2000 distinct stumps that accept every window, then a
+// stage that rejects it (~3 s of CPU per KITTI-sized stack here): the realistic way a detection
+// thread gets stuck in one stack.
+void writeSlowModel(const fs::path& file) {
+  std::ofstream out(file);
+  out << R"({"format": "fusedet-cascade", "version": 1, "class": "slow", "window": {"width": 14, "height": 24},)"
+      << R"( "layers": ["intensity"], "reference_hue": null, "stages": [)";
+  for (int s = 0; s < 5; ++s) {
+    out << R"({"threshold": -1e9, "stumps": [)";
+    for (int k = 0; k < 400; ++k) {
+      const int i = s * 400 + k;
+      out << (k ? "," : "") << R"({"type": "b", "rect": [)" << (i % 20) / 25.0 << ", " << ((i / 20) % 20) / 25.0 << ", "
+          << 0.1 + 0.02 * (i / 400) << R"(, 0.2], "layer": "intensity", "threshold": 0, "left": 1, "right": 1})";
+    }
+    out << "]},";
+  }
+  out << R"({"threshold": 1e9, "stumps": [{"type": "b", "rect": [0, 0, 0.5, 0.5], "layer": "intensity", "threshold": 0, "left": 1, "right": 1}]}]})";
+}
+}  // namespace
+
+// A detection thread stuck in one stack withholds WATCHDOG=1 (systemd would restart the service
+// after WatchdogSec) and STATUS= names it; when the stack is done the pings resume and STATUS= no
+// longer says stuck. One stack only (a one-stroke log, then idle), so the cost is one slow stack.
+TEST(Fusedetd, AStuckDetectionThreadWithholdsWatchdogAndStatusSaysSo) {
+  const fs::path dir = tempDir("stuck");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock", slow = dir / "slow.json";
+  writeSlowModel(slow);
+  writeConfig(config, socket, {"car"},
+              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(1).string() + "\n  at_end: idle\n");
+  {
+    std::string text = readFile(config);
+    const auto at = text.find("  models: [");
+    text.replace(at, text.find('\n', at) - at, "  models: [" + slow.string() + "]\n  threads: 1");
+    std::ofstream(config) << text;
+  }
+  NotifySocket notify(dir / "notify");
+  // WATCHDOG_USEC 1 s: a ping every 250 ms while every thread showed life within 500 ms.
+  Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=1000000"}, dir / "log");
+  ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
+  // STATUS= names the stuck thread and how long (whole seconds); no ping while it is stuck.
+  ASSERT_TRUE(notify.waitFor("detection thread stuck for 1 s", 120s)) << readFile(dir / "log");
+  EXPECT_NE(notify.lastMatch().find("STATUS=replay"), std::string::npos) << notify.lastMatch();
+  notify.clear();
+  ASSERT_TRUE(notify.waitFor("detection thread stuck for 2 s", 60s)) << readFile(dir / "log");
+  EXPECT_EQ(notify.count("WATCHDOG=1"), 0);
+  // The stack done, the pings resume and STATUS= no longer says stuck.
+  ASSERT_TRUE(notify.waitFor("WATCHDOG=1", 300s)) << readFile(dir / "log");
+  ASSERT_TRUE(notify.waitFor("STATUS=", 10s));
+  EXPECT_EQ(notify.lastMatch().find("stuck"), std::string::npos) << notify.lastMatch();
+  notify.clear();
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_GE(notify.count("WATCHDOG=1"), 3);
+  EXPECT_NE(readFile(dir / "log").find("watchdog: detection thread stuck for"), std::string::npos);
+  ::kill(daemon.pid(), SIGTERM);
+  EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+}

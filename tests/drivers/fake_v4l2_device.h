@@ -79,12 +79,18 @@ class FakeV4l2Device final : public drivers::v4l2::V4l2Io {
     return static_cast<std::uint8_t>((sequence * 7 + offset) & 0xFF);
   }
 
-  fusedet::Result<void> open(const std::string&) override {
+  fusedet::Result<void> open(const std::string& path) override {
     std::lock_guard lock(mutex_);
     if (vanished || (!presenceFile.empty() && !std::filesystem::exists(presenceFile)))
       return errnoError(ENOENT, "open");
     open_ = true;
+    opened_.push_back(path);
     return {};
+  }
+  // Every path opened successfully, in order.
+  std::vector<std::string> openedPaths() const {
+    std::lock_guard lock(mutex_);
+    return opened_;
   }
   void close() override {
     std::lock_guard lock(mutex_);
@@ -297,8 +303,9 @@ class FakeV4l2Device final : public drivers::v4l2::V4l2Io {
     return 0;
   }
 
-  std::mutex mutex_;
+  mutable std::mutex mutex_;
   bool open_ = false;
+  std::vector<std::string> opened_;
   std::vector<std::vector<std::uint8_t>> memory_;
 };
 

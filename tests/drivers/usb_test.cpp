@@ -48,7 +48,7 @@ TEST(UsbMatch, RejectsWithAReason) {
 
 TEST(UsbMatch, FuzzedTextNeverCrashesAndRoundTrips) {
   std::mt19937 rng(3);
-  const std::string alphabet = "0123456789abcdefABCDEFxg: \t\n\x01\xff-";
+  const std::string alphabet = "0123456789abcdefABCDEFxg: \t\n\x01\xff-@.";
   for (int i = 0; i < 20000; ++i) {
     std::string s(rng() % 16, ' ');
     for (char& c : s) c = alphabet[rng() % alphabet.size()];
@@ -59,6 +59,31 @@ TEST(UsbMatch, FuzzedTextNeverCrashesAndRoundTrips) {
     EXPECT_EQ(again->vendor, m->vendor);
     EXPECT_EQ(again->product, m->product);
     EXPECT_EQ(again->serial, m->serial);
+    EXPECT_EQ(again->port, m->port);
+  }
+}
+
+TEST(UsbMatch, PortNamesThePlaceOnTheBus) {
+  auto m = parseUsbMatch("046d:0825@1-2.3");
+  ASSERT_TRUE(m) << m.error().message();
+  EXPECT_EQ(m->port, "1-2.3");
+  EXPECT_FALSE(m->serial);
+  EXPECT_EQ(m->toString(), "046d:0825@1-2.3");
+  EXPECT_TRUE(m->atPort("1-2.3"));
+  EXPECT_FALSE(m->atPort("1-2"));
+  auto both = parseUsbMatch("0403:6001:FT1@3-1");
+  ASSERT_TRUE(both);
+  EXPECT_EQ(both->serial, "FT1");
+  EXPECT_EQ(both->port, "3-1");
+  auto atInSerial = parseUsbMatch("0403:6001:A@B");  // not a port: part of the serial
+  ASSERT_TRUE(atInSerial);
+  EXPECT_EQ(atInSerial->serial, "A@B");
+  EXPECT_FALSE(atInSerial->port);
+  EXPECT_TRUE(parseUsbMatch("0403:6001")->atPort("9-9"));
+  for (const char* bad : {"0403:6001@", "0403:6001@1-", "0403:6001@-2", "0403:6001@1-2..3", "0403:6001@1.2-3", "0403:6001@usb1"}) {
+    auto e = parseUsbMatch(bad);
+    ASSERT_FALSE(e) << bad;
+    EXPECT_NE(e.error().context.find("is not BUS-PORT[.PORT...]"), std::string::npos) << e.error().context;
   }
 }
 
@@ -160,6 +185,63 @@ TEST(UsbSysfs, DeviceNamesAndNodeNames) {
   EXPECT_FALSE(isDeviceNodeName("event7"));
 }
 
+TEST_F(FakeSysfs, ResolvesANodeFromSysfsAloneAndFollowsARePlug) {
+  const UsbSysfs s = sysfs();
+  const auto all = listFromSysfs(s);
+  ASSERT_EQ(all.size(), 5u);  // adapter, hub, camera, ACM, (root hub excluded)
+  EXPECT_EQ(*resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825"), "video"), "/dev/video0");
+  EXPECT_EQ(*resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825:  C0FFEE"), "video"), "/dev/video0");
+  EXPECT_EQ(*resolveNodeFromSysfs(s, *parseUsbMatch("0403:6001@1-1"), "ttyUSB"), "/dev/ttyUSB0");
+  auto absent = resolveNodeFromSysfs(s, *parseUsbMatch("046d:0990"), "video");
+  ASSERT_FALSE(absent);
+  EXPECT_EQ(absent.error().code, std::errc::no_such_device);
+  EXPECT_EQ(absent.error().context, "usb 046d:0990: no such device connected");
+  auto wrongPort = resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825@1-3"), "video");
+  ASSERT_FALSE(wrongPort);
+  EXPECT_EQ(wrongPort.error().code, std::errc::no_such_device);
+  auto hub = resolveNodeFromSysfs(s, *parseUsbMatch("05e3:0610"), "video");
+  ASSERT_FALSE(hub);
+  EXPECT_EQ(hub.error().code, std::errc::no_such_device_or_address);
+
+  // A second camera of the same kind: ambiguous without a serial or port.
+  device("1-6", {{"idVendor", "046d"}, {"idProduct", "0825"}, {"busnum", "1"}, {"devnum", "9"}});
+  dir("1-6/1-6:1.0/video4linux/video2");
+  auto two = resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825"), "video");
+  ASSERT_FALSE(two);
+  EXPECT_EQ(two.error().code, std::errc::invalid_argument);
+  EXPECT_NE(two.error().context.find("2 devices match (1-2.3 serial   C0FFEE, 1-6 (no serial))"), std::string::npos)
+      << two.error().context;
+  EXPECT_EQ(*resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825@1-6"), "video"), "/dev/video2");
+  EXPECT_EQ(listFromSysfs(s, *parseUsbMatch("046d:0825@1-6")).at(0).address, 9);
+
+  // Unplugged: gone from sysfs. Re-plugged into another socket: a new name and a new node.
+  fs::remove(root / "sys/bus/usb/devices/1-2.3");
+  fs::remove_all(devices / "1-2/1-2.3");
+  fs::remove(root / "sys/bus/usb/devices/1-6");
+  fs::remove_all(devices / "1-6");
+  EXPECT_EQ(resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825"), "video").error().code, std::errc::no_such_device);
+  device("1-7", {{"idVendor", "046d"}, {"idProduct", "0825"}});
+  dir("1-7/1-7:1.0");  // uvcvideo not bound yet
+  EXPECT_EQ(resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825"), "video").error().code, std::errc::no_such_device_or_address);
+  dir("1-7/1-7:1.0/video4linux/video4");
+  EXPECT_EQ(*resolveNodeFromSysfs(s, *parseUsbMatch("046d:0825"), "video"), "/dev/video4");
+}
+
+TEST(UsbSysfs, MissingOrGarbageTreeListsNothing) {
+  EXPECT_TRUE(listFromSysfs(UsbSysfs("/nonexistent-sysfs")).empty());
+  const fs::path root = fs::temp_directory_path() / ("fusedet-sysfs-garbage-" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root / "bus/usb/devices/1-1");
+  std::ofstream(root / "bus/usb/devices/1-1/idVendor") << "zz\n";
+  std::ofstream(root / "bus/usb/devices/1-1/idProduct") << "0825\n";
+  fs::create_directories(root / "bus/usb/devices/1-2");
+  std::ofstream(root / "bus/usb/devices/1-2/idVendor") << "123456\n";
+  std::ofstream(root / "bus/usb/devices/1-2/idProduct") << "1\n";
+  fs::create_directories(root / "bus/usb/devices/1-3");  // no attributes at all
+  EXPECT_TRUE(listFromSysfs(UsbSysfs(root)).empty());
+  fs::remove_all(root);
+}
+
 UsbDeviceInfo dev(std::uint16_t vid, std::uint16_t pid, std::string name, std::optional<std::string> serial,
                   std::vector<std::string> nodes = {}) {
   UsbDeviceInfo d;
@@ -180,7 +262,7 @@ TEST(UsbSelect, ExactlyOneMustMatch) {
   auto two = selectOne(devices, *parseUsbMatch("0403:6001"));
   ASSERT_FALSE(two);
   EXPECT_EQ(two.error().context,
-            "usb 0403:6001: 2 devices match (1-1 serial A, 1-3 (no serial)); add the serial: VID:PID:SERIAL");
+            "usb 0403:6001: 2 devices match (1-1 serial A, 1-3 (no serial)); add the serial (VID:PID:SERIAL) or the port (VID:PID@PORT)");
   auto bySerial = selectOne(devices, *parseUsbMatch("0403:6001:A"));
   ASSERT_TRUE(bySerial);
   EXPECT_EQ(bySerial->name, "1-1");

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <mutex>
 #include <random>
 #include <thread>
 
@@ -504,6 +505,52 @@ TEST(V4l2FrameStream, ReopensAfterTheDeviceVanishesAndReturns) {
   const FrameStreamCounters c = rig.stream->counters();
   EXPECT_EQ(c.reopens, 1u);
   EXPECT_NE(c.lastError.find("No such file"), std::string::npos) << c.lastError;
+}
+
+// A USB camera named by VID:PID: the node is looked up before every open; while the device is
+// absent nothing is opened and the lookup's reason is reported; re-plugged, it may have a new node.
+TEST(V4l2FrameStream, AResolverFindsTheNodeAnewAfterARePlug) {
+  FrameStreamTiming t;
+  t.readTimeout = 5ms;
+  t.stallLimit = 10s;
+  StreamRig rig(t);
+  std::mutex m;
+  std::string current;  // empty: the device is not plugged in
+  const std::string absent = "usb 046d:0825: no such device connected";
+  rig.stream->setDeviceResolver([&]() -> fusedet::Result<std::string> {
+    std::lock_guard lock(m);
+    if (current.empty()) return fusedet::makeError(std::errc::no_such_device, absent);
+    return current;
+  });
+  for (std::uint32_t i = 0; i < 3; ++i) rig.fake->script.push_back(FakeFrame{i});
+  rig.stream->start();
+  ASSERT_TRUE(rig.waitFor([&] { return rig.stream->counters().lastError == absent; }));
+  EXPECT_TRUE(rig.fake->openedPaths().empty());
+  {
+    std::lock_guard lock(m);
+    current = "/dev/fake-video0";
+  }
+  rig.stream->deviceArrived();
+  ASSERT_TRUE(rig.waitFor([&] { return rig.frames.load() == 3; }));
+  // Unplugged: every call fails and the lookup finds nothing.
+  {
+    std::lock_guard lock(m);
+    current.clear();
+  }
+  rig.fake->vanished = true;
+  ASSERT_TRUE(rig.waitFor([&] {
+    return rig.stream->counters().lastError == absent && rig.stream->state() != fusedet::drivers::StreamState::kStreaming;
+  }));
+  // Re-plugged elsewhere: a new node.
+  rig.fake->vanished = false;
+  rig.fake->addFrames({FakeFrame{0}, FakeFrame{1}});
+  {
+    std::lock_guard lock(m);
+    current = "/dev/fake-video3";
+  }
+  ASSERT_TRUE(rig.waitFor([&] { return rig.frames.load() == 5; }));
+  EXPECT_EQ(rig.fake->openedPaths(), (std::vector<std::string>{"/dev/fake-video0", "/dev/fake-video3"}));
+  EXPECT_EQ(rig.stream->counters().reopens, 1u);
 }
 
 }  // namespace

@@ -67,6 +67,10 @@ class Service {
   nlohmann::json status() const;
   // True when the fusion, detection and server threads all showed life within maxAgeNs.
   bool alive(std::int64_t maxAgeNs) const;
+  // "" when alive; else which threads showed no life within maxAgeNs and for how long, e.g.
+  // "detection thread stuck for 3 s" (whole seconds, "<1 s" before the first: STATUS= changes
+  // at most once a second).
+  std::string stalled(std::int64_t maxAgeNs) const;
   // One line for systemd's STATUS=.
   std::string summary() const;
   // Every source is finite and has delivered everything, and the pipeline is idle: all results

@@ -32,6 +32,14 @@ Result<UsbDeviceInfo> selectOne(const std::vector<UsbDeviceInfo>& devices, const
 // no_such_device_or_address when the device has none (its driver not bound yet, or another kind).
 Result<std::string> nodeOf(const UsbDeviceInfo& device, const std::string& prefix);
 
+// The devices sysfs shows under <sysRoot>/bus/usb/devices (root hubs excluded), those matching
+// `match` (ids, serial, port), in port order. Needs no libusb or usbfs, only a readable /sys: what
+// a sandboxed service can always do. bus/address come from busnum/devnum.
+std::vector<UsbDeviceInfo> listFromSysfs(const UsbSysfs& sysfs, const std::optional<UsbMatch>& match = std::nullopt);
+// The node (name starting with `prefix`) of the one device matching `match`, from sysfs alone:
+// errors as selectOne (none: no_such_device; several: invalid_argument) and nodeOf (no node yet).
+Result<std::string> resolveNodeFromSysfs(const UsbSysfs& sysfs, const UsbMatch& match, const std::string& prefix);
+
 class UsbBus {
  public:
   // libusb_init. Errors (io_error) carry libusb's words, e.g. when the machine has no usbfs.

@@ -114,6 +114,8 @@ class V4l2Camera {
 
   void setRawHook(RawHook hook) { rawHook_ = std::move(hook); }
   const CameraConfig& config() const { return config_; }
+  // Another node for the next start() (a USB camera found under a new name); only while stopped.
+  void setDevice(std::string device) { config_.device = std::move(device); }
   CameraCounters counters() const;
   bool streaming() const { return streaming_; }
 

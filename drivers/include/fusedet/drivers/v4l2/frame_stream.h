@@ -5,6 +5,9 @@
 // absent it is watched every 20 ms and reopened as soon as it is back; other failures back off
 // (50 ms doubling to `reconnectMax`). deviceArrived() (e.g. from a USB hotplug callback) ends a
 // back-off at once. stop() joins the thread and leaves the device closed.
+// With a device resolver (a USB camera named by VID:PID, whose node may change when re-plugged)
+// the node is looked up anew before every open, and while the device is absent the lookup is
+// repeated every 100 ms instead of watching the old node.
 
 #include <atomic>
 #include <chrono>
@@ -39,6 +42,8 @@ struct FrameStreamCounters {
 class FrameStream {
  public:
   using FrameHandler = std::function<void(const CameraFrame&)>;
+  // Returns the node to open, or why there is none now (device absent, driver not bound yet).
+  using DeviceResolver = std::function<Result<std::string>()>;
   FrameStream(CameraConfig config, FrameHandler onFrame, FrameStreamTiming timing = {},
               std::unique_ptr<V4l2Io> io = makeKernelIo());
   ~FrameStream();
@@ -47,6 +52,9 @@ class FrameStream {
 
   // Recording hook: every dequeued buffer (call before start()).
   void setRawHook(RawHook hook) { camera_.setRawHook(std::move(hook)); }
+  // Where the node is found before every open (call before start()); CameraConfig::device is
+  // then only the first guess, replaced by what the resolver returns.
+  void setDeviceResolver(DeviceResolver resolver) { resolver_ = std::move(resolver); }
 
   void start();
   void stop();
@@ -61,12 +69,15 @@ class FrameStream {
   void run();
   bool sleepFor(std::chrono::milliseconds d);  // false once stop() was called
   bool waitForDevice();                       // until the node exists; false once stopped
+  bool resolveDevice();                       // true: camera_ names the resolver's node
   void stream();                              // streams until stop, a device error or a reopen is due
   void noteError(const Error& e);
   static constexpr std::chrono::milliseconds kDevicePoll{20};
+  static constexpr std::chrono::milliseconds kResolvePoll{100};  // a sysfs scan: cheap, not free
 
   V4l2Camera camera_;
   FrameHandler onFrame_;
+  DeviceResolver resolver_;
   FrameStreamTiming timing_;
   std::atomic<StreamState> state_{StreamState::kStopped};
   std::atomic<bool> running_{false};
