@@ -2,7 +2,7 @@
 // layout: /sys/bus/usb/devices/<port> -> the device, <port>:1.0/video4linux/videoN). The id is
 // looked up before every open, an absent camera is reported by its id, and a camera re-plugged
 // into another socket is found under its new node. The "nodes" are regular files, so opening one
-// fails with "not a V4L2 device": that error names the node the source chose.
+// fails with "not a character device": that error names the node the source chose.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -83,15 +83,15 @@ TEST_F(CameraUsb, OpensTheNodeOfTheUsbIdAndFindsItAgainAfterARePlug) {
   CameraSource source(config("046d:0825"), sysfs());
   NullSink sink;
   source.start(sink);
-  const std::string video0 = "camera " + (root / "dev/video0").string() + ": not a V4L2 device";
+  const std::string video0 = "camera " + (root / "dev/video0").string() + ": not a character device";
   ASSERT_TRUE(waitFor([&] { return lastError(source).find(video0) != std::string::npos; })) << lastError(source);
 
   unplug("1-2");
-  ASSERT_TRUE(waitFor([&] { return lastError(source) == "usb 046d:0825: no such device connected"; })) << lastError(source);
+  ASSERT_TRUE(waitFor([&] { return lastError(source).find("usb 046d:0825: no such device connected") == 0; })) << lastError(source);
   EXPECT_EQ(source.health().at(0).state, "backing off");
 
   plug("1-4", 3);  // another socket: another node
-  const std::string video3 = "camera " + (root / "dev/video3").string() + ": not a V4L2 device";
+  const std::string video3 = "camera " + (root / "dev/video3").string() + ": not a character device";
   ASSERT_TRUE(waitFor([&] { return lastError(source).find(video3) != std::string::npos; })) << lastError(source);
   EXPECT_EQ(sink.frames.load(), 0);
   source.stop();
@@ -112,7 +112,7 @@ TEST_F(CameraUsb, TwoIdenticalCamerasNeedASerialOrAPort) {
     CameraSource source(config(usb), sysfs());
     NullSink sink;
     source.start(sink);
-    const std::string want = "camera " + (root / "dev" / node).string() + ": not a V4L2 device";
+    const std::string want = "camera " + (root / "dev" / node).string() + ": not a character device";
     EXPECT_TRUE(waitFor([&] { return lastError(source).find(want) != std::string::npos; })) << usb << ": " << lastError(source);
   }
 }
