@@ -1,15 +1,18 @@
 // fusedet log: inspect and export MCAP sensor logs (docs/log-format.md).
 //   info LOG                          channels, counts, time span, gaps, damage (where a cut file was cut)
 //   export LOG --candump F | --png DIR | --ply DIR
+//   derive IN OUT [--models M...]     IN plus the channels a viewer needs (daemon/log_derive.h)
 
 #include <cstdio>
 
 #include "command.h"
 #include "fusedet/daemon/config.h"
+#include "fusedet/daemon/log_derive.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/drivers/log/candump.h"
 #include "fusedet/drivers/log/log_info.h"
 #include "fusedet/fusion/log_export.h"
+#include "model_files.h"
 
 namespace fusedet::tools {
 namespace {
@@ -18,7 +21,28 @@ struct LogOptions {
   std::string file;
   double gapFactor = 3.0;
   std::string candump, png, ply;
+  std::string out;
+  std::vector<std::string> models{"models"};
+  bool noDetections = false;
 };
+
+int runDerive(const LogOptions& o) {
+  daemon::DeriveOptions d;
+  if (!o.noDetections) d.models = modelFiles(o.models);
+  const daemon::DeriveReport r = daemon::deriveLog(o.file, o.out, d);
+  std::printf("derive   %s -> %s: %ju raw messages copied, %ju derived messages of the input left out\n", o.file.c_str(),
+              o.out.c_str(), static_cast<std::uintmax_t>(r.copied), static_cast<std::uintmax_t>(r.dropped));
+  std::printf("laser    %ju scans, %ju tilt samples (%ju transforms), %ju sweeps with %ju points\n",
+              static_cast<std::uintmax_t>(r.scans), static_cast<std::uintmax_t>(r.tiltSamples),
+              static_cast<std::uintmax_t>(r.transforms), static_cast<std::uintmax_t>(r.sweeps),
+              static_cast<std::uintmax_t>(r.points));
+  std::string classes;
+  for (const std::string& c : r.classes) classes += " " + c;
+  std::printf("camera   %ju frames, %ju fused stacks%s, %ju detections (classes:%s)\n", static_cast<std::uintmax_t>(r.frames),
+              static_cast<std::uintmax_t>(r.stacks), r.calibrated ? "" : " (no camera calibration in the log)",
+              static_cast<std::uintmax_t>(r.detections), classes.empty() ? " none" : classes.c_str());
+  return 0;
+}
 
 int runInfo(const LogOptions& o) {
   const drivers::mcap::McapReader reader(o.file);
@@ -54,6 +78,11 @@ const bool registered = registerCommand(
       info->add_option("LOG", o->file, "an MCAP file")->required();
       info->add_option("--gap-factor", o->gapFactor, "an interval longer than this many usual periods (90th percentile of the intervals) counts as a gap")
           ->capture_default_str();
+      CLI::App* derive = app.add_subcommand("derive", "copy a log and add what a viewer shows: scans, tilt transforms, sweeps, detections");
+      derive->add_option("IN", o->file, "an MCAP log with raw channels and its rig (fusedet.config)")->required();
+      derive->add_option("OUT", o->out, "the MCAP log to write")->required();
+      derive->add_option("--models", o->models, "model files, or folders of *.json models, to detect with")->capture_default_str();
+      derive->add_flag("--no-detections", o->noDetections, "no /detections channel (no models needed)");
       CLI::App* exp = app.add_subcommand("export", "write a log's CAN frames, camera frames or sweeps in other tools' formats");
       exp->add_option("LOG", o->file, "an MCAP file")->required();
       exp->add_option("--candump", o->candump, "CAN frames as a can-utils `candump -l` log (log2asc, canplayer read it)");
@@ -68,14 +97,23 @@ const bool registered = registerCommand(
           "export decodes camera frames as the live pipeline does (YUYV/MJPEG -> BGR) and takes the sweeps the log\n"
           "recorded, or assembles them from its raw laser and CAN streams with the rig in its fusedet.config.\n"
           "candump stamps are the log's CLOCK_MONOTONIC seconds.\n"
+          "derive replays IN's raw channels through the live decoders, the sweep assembly, the fusion and the\n"
+          "detectors, configured from the rig IN carries, and writes OUT = IN's raw channels and metadata plus\n"
+          "/lms291/scan (foxglove.LaserScan, frame laser), /tilt/sample, /tf (foxglove.FrameTransform: laser_base ->\n"
+          "laser at every tilt sample, laser_base -> camera with every frame), /camera/calibration\n"
+          "(foxglove.CameraCalibration), /sweep/points (foxglove.PointCloud, frame laser_base) and /detections\n"
+          "(foxglove.ImageAnnotations on the camera image, stamped like the frame): open OUT in Foxglove to see the\n"
+          "camera with its detections and the sweeps in 3D. Derived channels IN had are computed again, not copied.\n"
           "Examples:\n"
           "  fusedet log info run.mcap\n"
           "  fusedet log export run.mcap --candump tilt.log && log2asc -I tilt.log -O tilt.asc can0\n"
           "  fusedet log export run.mcap --png frames/ --ply sweeps/\n"
+          "  fusedet log derive run.mcap run-view.mcap --models models/\n"
           "Exit status: 0 for an intact file (info) or a finished export; 3 when info finds the file truncated or\n"
           "damaged (the report still lists what is readable); 1 on errors ('fusedet log: error: ...').");
-      return [o, info, exp]() -> int {
+      return [o, info, exp, derive]() -> int {
         if (info->parsed()) return runInfo(*o);
+        if (derive->parsed()) return runDerive(*o);
         if (exp->parsed()) return runExport(*o);
         return 2;
       };

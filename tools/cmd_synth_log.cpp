@@ -6,7 +6,9 @@
 
 #include "command.h"
 #include "data_dir.h"
+#include "fusedet/daemon/log_derive.h"
 #include "fusedet/fusion/synth_log.h"
+#include "model_files.h"
 
 namespace fusedet::tools {
 namespace {
@@ -15,6 +17,8 @@ struct SynthCliOptions {
   std::string kitti;
   std::string out;
   bool procedural = false;
+  bool derived = false;
+  std::vector<std::string> models{"models"};
   fusion::SynthOptions synth;
 };
 
@@ -31,7 +35,18 @@ int run(SynthCliOptions o) {
     }
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const fusion::SynthReport r = fusion::synthesizeLog(o.synth, o.out);
+  // --derived: the raw log goes to a temporary file first, then `log derive` writes OUT.
+  const std::vector<fs::path> models = o.derived ? modelFiles(o.models) : std::vector<fs::path>{};
+  const fs::path raw = o.derived ? fs::path(o.out + ".raw.tmp") : fs::path(o.out);
+  const fusion::SynthReport r = fusion::synthesizeLog(o.synth, raw);
+  if (o.derived) {
+    const daemon::DeriveReport d = daemon::deriveLog(raw, o.out, daemon::DeriveOptions{models});
+    fs::remove(raw);
+    std::printf("derived  %ju scans, %ju sweeps (%ju points), %ju stacks, %ju detections, %ju transforms\n",
+                static_cast<std::uintmax_t>(d.scans), static_cast<std::uintmax_t>(d.sweeps), static_cast<std::uintmax_t>(d.points),
+                static_cast<std::uintmax_t>(d.stacks), static_cast<std::uintmax_t>(d.detections),
+                static_cast<std::uintmax_t>(d.transforms));
+  }
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote    %s (%ju bytes) in %.2f s\n", o.out.c_str(), static_cast<std::uintmax_t>(fs::file_size(o.out)), took);
   std::printf("scene    %s\nframes  ", r.scene.c_str());
@@ -61,6 +76,10 @@ const bool registered = registerCommand(
       app.add_option("--first", o->synth.first, "index of the first KITTI frame (-1: the first of the held-back last third)")
           ->capture_default_str();
       app.add_option("--camera-fps", o->synth.cameraFps, "camera frame rate")->capture_default_str();
+      app.add_flag("--derived", o->derived,
+                   "add the channels a viewer shows (as fusedet log derive): scans, tilt transforms, camera calibration, "
+                   "sweeps as point clouds, detections of --models as image annotations");
+      app.add_option("--models", o->models, "with --derived: model files, or folders of *.json models")->capture_default_str();
       app.add_option("--tolerance-deg", o->synth.toleranceDeg, "max angle between a beam and the Velodyne return it takes")
           ->capture_default_str();
       app.footer(
@@ -78,6 +97,7 @@ const bool registered = registerCommand(
           "  fusedet synth-log --out build/logs/kitti.mcap\n"
           "  fusedet synth-log --kitti ../shared/data/kitti_0009 --frames 10 --first 0 --out drive9.mcap\n"
           "  fusedet synth-log --procedural --frames 3 --out scene.mcap && fusedet log info scene.mcap\n"
+          "  fusedet synth-log --derived --models models/ --out view.mcap   (open view.mcap in Foxglove)\n"
           "Exit status: 0 on success, 1 on errors ('fusedet synth-log: error: ...'). Data derived from KITTI is CC BY-NC-SA\n"
           "3.0: do not commit such logs.");
       return [o]() -> int { return run(*o); };

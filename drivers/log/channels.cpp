@@ -24,6 +24,7 @@ std::string object(const std::string& title, const std::string& props) {
 std::string pose() { return std::string(R"("pose":{"type":"object","properties":{"position":)") + kVec3 + R"(,"orientation":)" + kQuat + "}}"; }
 const std::string kBytes = R"({"type":"string","contentEncoding":"base64"})";
 const std::string kNumberArray = R"({"type":"array","items":{"type":"number"}})";
+const std::string kColor = R"({"type":"object","properties":{"r":{"type":"number"},"g":{"type":"number"},"b":{"type":"number"},"a":{"type":"number"}}})";
 
 const std::string& schemaText(Schema s) {
   static const std::string texts[] = {
@@ -41,15 +42,20 @@ const std::string& schemaText(Schema s) {
       object("foxglove.PointCloud", R"("frame_id":{"type":"string"},)" + pose() + R"(,"point_stride":{"type":"integer"},)"
                                     R"("fields":{"type":"array","items":{"type":"object","properties":{"name":{"type":"string"},)"
                                     R"("offset":{"type":"integer"},"type":{"type":"integer"}}}},"data":)" + kBytes),
-      R"({"title":"foxglove.ImageAnnotations","type":"object","properties":{"circles":{"type":"array"},)"
+      R"({"title":"foxglove.ImageAnnotations","type":"object","properties":{)" + std::string(kTimeProp) + R"(,"circles":{"type":"array"},)"
       R"("points":{"type":"array","items":{"type":"object","properties":{)" + std::string(kTimeProp) +
           R"(,"type":{"type":"integer"},"points":{"type":"array","items":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"}}}},)"
-          R"("outline_color":{"type":"object"},"thickness":{"type":"number"}}}},)"
+          R"("outline_color":)" + kColor + R"(,"outline_colors":{"type":"array","items":)" + kColor + R"(},"fill_color":)" + kColor +
+          R"(,"thickness":{"type":"number"}}}},)"
           R"("texts":{"type":"array","items":{"type":"object","properties":{)" + std::string(kTimeProp) +
-          R"(,"position":{"type":"object"},"text":{"type":"string"},"font_size":{"type":"number"}}}}}})",
+          R"(,"position":{"type":"object","properties":{"x":{"type":"number"},"y":{"type":"number"}}},"text":{"type":"string"},)"
+          R"("font_size":{"type":"number"},"text_color":)" + kColor + R"(,"background_color":)" + kColor + "}}}}}",
       std::string(R"({"title":"foxglove.FrameTransform","type":"object","properties":{)") + kTimeProp +
           R"(,"parent_frame_id":{"type":"string"},"child_frame_id":{"type":"string"},"translation":)" + kVec3 +
           R"(,"rotation":)" + kQuat + "}}",
+      object("foxglove.CameraCalibration", R"("frame_id":{"type":"string"},"width":{"type":"integer"},"height":{"type":"integer"},)"
+                                           R"("distortion_model":{"type":"string"},"D":)" + kNumberArray + R"(,"K":)" + kNumberArray +
+                                           R"(,"R":)" + kNumberArray + R"(,"P":)" + kNumberArray),
   };
   return texts[static_cast<int>(s)];
 }
@@ -103,7 +109,8 @@ constexpr double kBearingOffset = M_PI / 2;
 std::string_view schemaName(Schema s) {
   static constexpr std::string_view names[] = {"fusedet.RawSerial", "fusedet.CanFrame", "foxglove.RawImage",
                                                "foxglove.CompressedImage", "foxglove.LaserScan", "fusedet.TiltSample",
-                                               "foxglove.PointCloud", "foxglove.ImageAnnotations", "foxglove.FrameTransform"};
+                                               "foxglove.PointCloud", "foxglove.ImageAnnotations", "foxglove.FrameTransform",
+                                               "foxglove.CameraCalibration"};
   return names[static_cast<int>(s)];
 }
 std::string_view schemaJson(Schema s) { return schemaText(s); }
@@ -174,18 +181,24 @@ std::vector<std::uint8_t> encode(const PointCloudMessage& m) {
 std::vector<std::uint8_t> encode(const AnnotationsMessage& m) {
   json points = json::array(), texts = json::array();
   const json colour{{"r", 1.0}, {"g", 0.8}, {"b", 0.0}, {"a", 1.0}};
+  const json clear{{"r", 0.0}, {"g", 0.0}, {"b", 0.0}, {"a", 0.0}};
   for (const Annotation& a : m.boxes) {
     constexpr int kLineLoop = 2;  // foxglove.PointsAnnotationType LINE_LOOP
     points.push_back({{"timestamp", timestamp(m.stamp)}, {"type", kLineLoop},
                       {"points", json::array({{{"x", a.x}, {"y", a.y}}, {{"x", a.x + a.width}, {"y", a.y}},
                                               {{"x", a.x + a.width}, {"y", a.y + a.height}}, {{"x", a.x}, {"y", a.y + a.height}}})},
-                      {"outline_color", colour}, {"thickness", 2.0}});
+                      {"outline_color", colour}, {"outline_colors", json::array()}, {"fill_color", clear}, {"thickness", 2.0}});
     char text[96];
     std::snprintf(text, sizeof text, "%s %.2f", a.label.c_str(), a.score);
     texts.push_back({{"timestamp", timestamp(m.stamp)}, {"position", {{"x", a.x}, {"y", a.y}}}, {"text", text},
                      {"font_size", 14.0}, {"text_color", colour}, {"background_color", {{"r", 0}, {"g", 0}, {"b", 0}, {"a", 0.6}}}});
   }
-  return bytesOf(json{{"circles", json::array()}, {"points", points}, {"texts", texts}});
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"circles", json::array()}, {"points", points}, {"texts", texts}});
+}
+
+std::vector<std::uint8_t> encode(const CameraCalibrationMessage& m) {
+  return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"frame_id", m.frame}, {"width", m.width}, {"height", m.height},
+                      {"distortion_model", m.distortionModel}, {"D", m.D}, {"K", m.K}, {"R", m.R}, {"P", m.P}});
 }
 
 std::vector<std::uint8_t> encode(const TransformMessage& m) {

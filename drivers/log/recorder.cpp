@@ -44,7 +44,7 @@ void Recorder::addMetadata(const std::string& name, const mcap::StringMap& entri
   }
 }
 
-void Recorder::write(const char* topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& data) {
+void Recorder::write(const std::string& topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& data) {
   std::lock_guard lock(mutex_);
   if (closed_ || !error_.empty()) return;
   try {
@@ -76,6 +76,12 @@ void Recorder::record(const TiltSample& m) { write(topic::kTilt, Schema::kTiltSa
 void Recorder::record(const PointCloudMessage& m) { write(topic::kSweep, Schema::kPointCloud, m.stamp, encode(m)); }
 void Recorder::record(const AnnotationsMessage& m) { write(topic::kDetections, Schema::kImageAnnotations, m.stamp, encode(m)); }
 void Recorder::record(const TransformMessage& m) { write(topic::kTransforms, Schema::kFrameTransform, m.stamp, encode(m)); }
+void Recorder::record(const CameraCalibrationMessage& m) {
+  write(topic::kCameraCalibration, Schema::kCameraCalibration, m.stamp, encode(m));
+}
+void Recorder::recordEncoded(const std::string& topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& json) {
+  write(topic, schema, stamp, json);
+}
 
 void Recorder::flush() {
   std::lock_guard lock(mutex_);

@@ -70,6 +70,23 @@ int main(int argc, char** argv) {
   counts[topic::kDetections] = 1;
   rec.record(TransformMessage{Stamp{t0}, "laser_base", "camera", {0.1, 0.2, 0.3}, {0, 0, 0, 1}});
   counts[topic::kTransforms] = 1;
+  CameraCalibrationMessage calibration;
+  calibration.stamp = Stamp{t0};
+  calibration.width = 8;
+  calibration.height = 2;
+  calibration.D = {0.1, -0.2, 0, 0, 0};
+  calibration.K = {5, 0, 4, 0, 5, 1, 0, 0, 1};
+  calibration.P = {5, 0, 4, 0, 0, 5, 1, 0, 0, 0, 1, 0};
+  rec.record(calibration);
+  counts[topic::kCameraCalibration] = 1;
+  CameraFrame jpeg;  // an MJPEG buffer: its bytes pass through unchanged
+  jpeg.stamp = Stamp{t0 + 1'000'000};
+  jpeg.format = PixelFormat::kMjpeg;
+  jpeg.width = 8;
+  jpeg.height = 2;
+  jpeg.bytes = {0xFF, 0xD8, 0xFF, 0xD9};
+  rec.record(jpeg);
+  counts[topic::kCameraCompressed] = 1;
   rec.close();
   int total = 0;
   for (const auto& [k, v] : counts.items()) total += v.get<int>();
@@ -81,7 +98,9 @@ int main(int argc, char** argv) {
                                 {"schemas", {{topic::kLaserRaw, "fusedet.RawSerial"}, {topic::kCan, "fusedet.CanFrame"},
                                              {topic::kCameraRaw, "foxglove.RawImage"}, {topic::kLaserScan, "foxglove.LaserScan"},
                                              {topic::kSweep, "foxglove.PointCloud"}, {topic::kDetections, "foxglove.ImageAnnotations"},
-                                             {topic::kTransforms, "foxglove.FrameTransform"}, {topic::kTilt, "fusedet.TiltSample"}}}};
+                                             {topic::kTransforms, "foxglove.FrameTransform"}, {topic::kTilt, "fusedet.TiltSample"},
+                                             {topic::kCameraCalibration, "foxglove.CameraCalibration"},
+                                             {topic::kCameraCompressed, "foxglove.CompressedImage"}}}};
   std::printf("%s\n", expected.dump().c_str());
   return 0;
 }

@@ -10,7 +10,7 @@
 // Decoded and derived data (for viewers; replay recomputes them from the raw streams):
 //   /lms291/scan     foxglove.LaserScan      /tilt/sample  fusedet.TiltSample
 //   /sweep/points    foxglove.PointCloud     /detections   foxglove.ImageAnnotations
-//   /tf              foxglove.FrameTransform
+//   /tf              foxglove.FrameTransform  /camera/calibration foxglove.CameraCalibration
 // Metadata record "fusedet.config": "config.yaml" (fusedet.yaml format), "camera.yaml" (ROS
 // camera_info); see docs/log-format.md.
 
@@ -37,6 +37,7 @@ inline constexpr char kTilt[] = "/tilt/sample";
 inline constexpr char kSweep[] = "/sweep/points";
 inline constexpr char kDetections[] = "/detections";
 inline constexpr char kTransforms[] = "/tf";
+inline constexpr char kCameraCalibration[] = "/camera/calibration";
 }  // namespace topic
 
 // Metadata record names and keys.
@@ -47,11 +48,12 @@ inline constexpr char kRecordingMetadata[] = "fusedet.recording";
 
 enum class Schema {
   kRawSerial, kCanFrame, kRawImage, kCompressedImage, kLaserScan, kTiltSample, kPointCloud,
-  kImageAnnotations, kFrameTransform,
+  kImageAnnotations, kFrameTransform, kCameraCalibration,
 };
 inline constexpr std::array kAllSchemas = {Schema::kRawSerial, Schema::kCanFrame, Schema::kRawImage,
                                            Schema::kCompressedImage, Schema::kLaserScan, Schema::kTiltSample,
-                                           Schema::kPointCloud, Schema::kImageAnnotations, Schema::kFrameTransform};
+                                           Schema::kPointCloud, Schema::kImageAnnotations, Schema::kFrameTransform,
+                                           Schema::kCameraCalibration};
 std::string_view schemaName(Schema s);  // "fusedet.RawSerial", "foxglove.RawImage", ...
 std::string_view schemaJson(Schema s);  // its JSON Schema text
 std::optional<Schema> schemaByName(std::string_view name);
@@ -98,6 +100,19 @@ struct TransformMessage {
   std::array<double, 4> rotation{0, 0, 0, 1};  // quaternion x y z w
 };
 
+// The camera's intrinsics for viewers (ROS camera_info conventions): Foxglove projects the sweep
+// into the image and places the image in 3D with it.
+struct CameraCalibrationMessage {
+  Stamp stamp;
+  std::string frame = "camera";
+  int width = 0, height = 0;
+  std::string distortionModel = "plumb_bob";
+  std::vector<double> D;                             // distortion coefficients
+  std::array<double, 9> K{};                         // intrinsic matrix, row-major
+  std::array<double, 9> R{1, 0, 0, 0, 1, 0, 0, 0, 1};  // rectification
+  std::array<double, 12> P{};                        // projection matrix, row-major
+};
+
 // Encoders: the JSON message bytes of each channel.
 std::vector<std::uint8_t> encode(const SerialChunk& m);
 std::vector<std::uint8_t> encode(const CanMessage& m);
@@ -107,6 +122,7 @@ std::vector<std::uint8_t> encode(const TiltSample& m);
 std::vector<std::uint8_t> encode(const PointCloudMessage& m);
 std::vector<std::uint8_t> encode(const AnnotationsMessage& m);
 std::vector<std::uint8_t> encode(const TransformMessage& m);
+std::vector<std::uint8_t> encode(const CameraCalibrationMessage& m);
 Schema schemaOf(const CameraFrame& m);
 
 // Decoders: errors (std::errc::bad_message) name the field that is missing or malformed.

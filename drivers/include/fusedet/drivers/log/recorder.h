@@ -44,6 +44,9 @@ class Recorder {
   void record(const PointCloudMessage& m);
   void record(const AnnotationsMessage& m);
   void record(const TransformMessage& m);
+  void record(const CameraCalibrationMessage& m);
+  // A message already encoded for `topic` (its JSON bytes), e.g. copied from another log.
+  void recordEncoded(const std::string& topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& json);
 
   // Closes the open chunk now.
   void flush();
@@ -54,7 +57,7 @@ class Recorder {
   std::string error() const;  // empty while healthy
 
  private:
-  void write(const char* topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& data);
+  void write(const std::string& topic, Schema schema, Stamp stamp, const std::vector<std::uint8_t>& data);
   void flushLoop(std::chrono::milliseconds every);
 
   mutable std::mutex mutex_;

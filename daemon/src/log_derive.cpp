@@ -1,0 +1,190 @@
+#include "fusedet/daemon/log_derive.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "fusedet/daemon/config.h"
+#include "fusedet/daemon/rig.h"
+#include "fusedet/daemon/stack_detector.h"
+#include "fusedet/drivers/log/recorder.h"
+#include "fusedet/drivers/log/replay.h"
+#include "fusedet/fusion/camera_model.h"
+#include "fusedet/fusion/frame_decode.h"
+#include "fusedet/fusion/fuser.h"
+#include "fusedet/fusion/pairing.h"
+#include "fusedet/fusion/sweep_assembler.h"
+
+namespace fusedet::daemon {
+
+namespace logs = drivers::logs;
+namespace mcap = drivers::mcap;
+
+namespace {
+
+constexpr char kBaseFrame[] = "laser_base";  // the sweeps' frame: the nodding unit's fixed base
+constexpr char kLaserFrame[] = "laser";      // the scanner, turned by the tilt
+constexpr char kCameraFrame[] = "camera";
+
+// One derived message, kept until the raw messages around it are written (OUT in time order).
+struct Derived {
+  std::int64_t t;
+  std::string topic;
+  logs::Schema schema;
+  std::vector<std::uint8_t> json;
+};
+
+logs::TransformMessage transform(Stamp t, const std::string& parent, const std::string& child, const Eigen::Isometry3d& childInParent) {
+  const Eigen::Quaterniond q(childInParent.linear());
+  const Eigen::Vector3d p = childInParent.translation();
+  return logs::TransformMessage{t, parent, child, {p.x(), p.y(), p.z()}, {q.x(), q.y(), q.z(), q.w()}};
+}
+
+logs::CameraCalibrationMessage calibration(Stamp t, const fusion::CameraModel& c) {
+  logs::CameraCalibrationMessage m;
+  m.stamp = t;
+  m.frame = kCameraFrame;
+  m.width = c.width;
+  m.height = c.height;
+  m.distortionModel = c.distortion.size() > 5 ? "rational_polynomial" : "plumb_bob";
+  m.D = c.distortion;
+  for (int i = 0; i < 9; ++i) m.K[static_cast<std::size_t>(i)] = c.K(i / 3, i % 3);
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) m.P[static_cast<std::size_t>(r * 4 + k)] = c.K(r, k);  // P = [K | 0]
+  return m;
+}
+
+bool isRaw(const std::string& topic) {
+  return topic == logs::topic::kLaserRaw || topic == logs::topic::kCan || topic == logs::topic::kCameraRaw ||
+         topic == logs::topic::kCameraCompressed;
+}
+
+}  // namespace
+
+DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::path& out, const DeriveOptions& options) {
+  DeriveReport report;
+  const logs::LogSource probe(in);
+  const auto rig = probe.rig();
+  if (!rig) throw std::runtime_error(in.string() + ": no fusedet.config metadata (the rig) to replay it with");
+  const Config config = parseConfig(rig->configYaml, in.string() + ":config.yaml");
+  const fusion::SweepConfig sweepConfig = daemon::sweepConfig(config);
+  const Eigen::Isometry3d laserToCamera = daemon::laserToCamera(config);
+
+  std::optional<fusion::CameraModel> camera;
+  std::optional<fusion::Fuser> fuser;
+  if (!rig->cameraYaml.empty()) {
+    camera = fusion::parseCameraModel(rig->cameraYaml, in.string() + ":camera.yaml");
+    fusion::ProjectionConfig projection;
+    projection.laserLayerScale = config.fusion.laserLayerScale;
+    projection.holeFillRadius = config.fusion.holeFillRadius;
+    fuser.emplace(*camera, laserToCamera, projection);
+    report.calibrated = true;
+  }
+  std::unique_ptr<CascadeSet> detector;
+  if (!options.models.empty()) {
+    Config::Detection d = config.detection;
+    d.models.clear();
+    for (const auto& m : options.models) d.models.push_back(m.string());
+    detector = std::make_unique<CascadeSet>(d);
+    report.classes = detector->classes();
+  }
+
+  // Pass 1: replay IN and compute the derived messages.
+  std::vector<Derived> derived;
+  auto keep = [&](Stamp t, const char* topic, logs::Schema schema, std::vector<std::uint8_t> json) {
+    derived.push_back({t.ns, topic, schema, std::move(json)});
+  };
+  logs::SensorReplay replay(in, sensorReplayConfig(config));
+  fusion::SweepAssembler sweeps(sweepConfig);
+  fusion::FramePairer pairer(static_cast<std::int64_t>(config.fusion.maxPairSkewMs) * 1'000'000);
+  const Eigen::Vector3d axis = sweepConfig.tiltAxis.normalized();
+  auto takeSweeps = [&] {
+    for (fusion::Sweep& s : sweeps.takeSweeps()) {
+      logs::PointCloudMessage cloud{s.end, kBaseFrame, {}};
+      cloud.points.reserve(s.points.size());
+      for (const fusion::SweepPoint& p : s.points) cloud.points.push_back({p.x, p.y, p.z, p.remission});
+      ++report.sweeps;
+      report.points += s.points.size();
+      keep(s.end, logs::topic::kSweep, logs::Schema::kPointCloud, logs::encode(cloud));
+      if (!fuser) continue;
+      auto frame = pairer.pair(s);
+      if (!frame) continue;
+      auto bgr = fusion::decodeCameraFrame(*frame);
+      if (!bgr) continue;  // an undecodable frame: no stack (as the live pipeline)
+      LayerStack stack = fuser->fuse(*bgr, s);
+      stack.stamp = frame->stamp;
+      ++report.stacks;
+      if (!detector) continue;
+      logs::AnnotationsMessage a{frame->stamp, {}};
+      for (const Detection& d : detector->detect(stack))
+        a.boxes.push_back({d.className, d.score, d.box.x, d.box.y, d.box.w, d.box.h});
+      report.detections += a.boxes.size();
+      keep(frame->stamp, logs::topic::kDetections, logs::Schema::kImageAnnotations, logs::encode(a));
+    }
+  };
+  logs::SensorReplay::Handlers h;
+  h.scan = [&](const drivers::LaserScan& s) {
+    ++report.scans;
+    keep(s.stamp, logs::topic::kLaserScan, logs::Schema::kLaserScan, logs::encode(s));
+    sweeps.addScan(s);
+  };
+  h.tilt = [&](const drivers::TiltSample& t) {
+    ++report.tiltSamples;
+    keep(t.stamp, logs::topic::kTilt, logs::Schema::kTiltSample, logs::encode(t));
+    // SweepAssembler's geometry: p_base = Rot(axis, tilt) (p_scanner + offset).
+    Eigen::Isometry3d laserInBase = Eigen::Isometry3d::Identity();
+    laserInBase.linear() = Eigen::AngleAxisd(t.angle, axis).toRotationMatrix();
+    laserInBase.translation() = laserInBase.linear() * sweepConfig.tiltAxisOffset;
+    keep(t.stamp, logs::topic::kTransforms, logs::Schema::kFrameTransform, logs::encode(transform(t.stamp, kBaseFrame, kLaserFrame, laserInBase)));
+    ++report.transforms;
+    sweeps.addTilt(t);
+  };
+  h.frame = [&](const drivers::CameraFrame& f) {
+    ++report.frames;
+    keep(f.stamp, logs::topic::kTransforms, logs::Schema::kFrameTransform,
+         logs::encode(transform(f.stamp, kBaseFrame, kCameraFrame, laserToCamera.inverse())));
+    ++report.transforms;
+    if (camera) keep(f.stamp, logs::topic::kCameraCalibration, logs::Schema::kCameraCalibration, logs::encode(calibration(f.stamp, *camera)));
+    pairer.addFrame(f);
+  };
+  while (replay.step(h)) takeSweeps();
+  sweeps.flush();
+  takeSweeps();
+  std::stable_sort(derived.begin(), derived.end(), [](const Derived& a, const Derived& b) { return a.t < b.t; });
+
+  // Pass 2: OUT = IN's metadata and raw messages, with the derived ones merged in by time.
+  logs::Recorder rec(out, {}, std::chrono::milliseconds(0));
+  const mcap::McapReader reader(in);
+  for (const mcap::Metadata& m : reader.index().metadata) rec.addMetadata(m.name, m.entries);
+  std::string models;
+  for (const auto& m : options.models) models += (models.empty() ? "" : " ") + m.string();
+  rec.addMetadata("fusedet.derived", {{"from", in.string()}, {"models", models},
+                                      {"note", "derived channels computed by fusedet log derive from the raw channels"}});
+  std::size_t next = 0;
+  auto writeDerivedUntil = [&](std::int64_t t) {
+    for (; next < derived.size() && derived[next].t <= t; ++next)
+      rec.recordEncoded(derived[next].topic, derived[next].schema, Stamp{derived[next].t}, derived[next].json);
+  };
+  const mcap::LogIndex& x = reader.index();
+  mcap::MessageCursor cursor = reader.messages();
+  while (auto m = cursor.next()) {
+    const auto ch = x.channels.find(m->channelId);
+    if (ch == x.channels.end() || !isRaw(ch->second.topic)) {
+      ++report.dropped;
+      continue;
+    }
+    const auto sc = x.schemas.find(ch->second.schemaId);
+    const auto schema = sc == x.schemas.end() ? std::nullopt : logs::schemaByName(sc->second.name);
+    if (!schema) {
+      ++report.dropped;
+      continue;
+    }
+    writeDerivedUntil(static_cast<std::int64_t>(m->logTime));
+    rec.recordEncoded(ch->second.topic, *schema, Stamp{static_cast<std::int64_t>(m->logTime)}, m->data);
+    ++report.copied;
+  }
+  writeDerivedUntil(std::numeric_limits<std::int64_t>::max());
+  rec.close();
+  return report;
+}
+
+}  // namespace fusedet::daemon
