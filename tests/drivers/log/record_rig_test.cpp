@@ -148,12 +148,20 @@ TEST(RecordReplay, TiltLaserAndCameraReplayAsRecorded) {
               scans.size(), samples.size(), frames.size(), static_cast<unsigned long long>(replay.counters().raw.canFrames),
               static_cast<unsigned long long>(replay.counters().raw.serialChunks));
   // Laser: the live scans are a prefix (replay also decodes telegrams passed over while stopping).
+  // Values and sequence numbers exactly. Stamps: exactly on an idle machine (RecordReplay.
+  // ReplayedRawBytesGiveTheLiveScans checks that alone); with three drivers' threads on a loaded
+  // machine the live driver's stamps of telegrams read in one backlog (kept strictly increasing
+  // at the read time) were seen up to one scan period (13.3 ms) from what replay reconstructs
+  // from the recorded reads - bounded at two periods here, counted in the output.
   ASSERT_GE(scans.size(), liveScans.size());
+  std::size_t stampsDiffer = 0;
   for (std::size_t i = 0; i < liveScans.size(); ++i) {
-    EXPECT_EQ(scans[i].stamp, liveScans[i].stamp) << i;
+    stampsDiffer += scans[i].stamp != liveScans[i].stamp;
+    EXPECT_LE(std::abs(scans[i].stamp - liveScans[i].stamp), 27'000'000) << i;  // two scan periods
     EXPECT_EQ(scans[i].sequence, liveScans[i].sequence) << i;
     EXPECT_EQ(scans[i].ranges, liveScans[i].ranges) << i;
   }
+  std::printf("scan stamps: %zu of %zu differ from the live driver's\n", stampsDiffer, liveScans.size());
   // Tilt: every TPDO1 the drive decoded, decoded again from the recorded frames.
   ASSERT_EQ(samples.size(), liveTilt.size());
   for (std::size_t i = 0; i < samples.size(); ++i) {
