@@ -8,6 +8,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "fusedet/boost/negative_miner.h"
 #include "fusedet/boost/reference_hue.h"
 #include "fusedet/boost/sample_features.h"
 #include "fusedet/boost/sharded_samples.h"
@@ -121,6 +122,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     progress.onProgress(e);
   }
 
+  NegativeMiner miner(stacks);
   std::map<std::size_t, int> cascadeIndex;  // pool feature -> Cascade::features index
   std::size_t initialCandidates = 0;
   for (int stage = 1;; ++stage) {
@@ -134,7 +136,8 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     const std::size_t want = stage > config.maxStages ? 0 : wanted;
     const std::uint64_t seed = config.seed * 1000003ULL + std::uint64_t(stage);
     const NegativeHarvest harvest = job ? shardedHarvest(stacks, cascade, want, seed, config.threads, *job)
-                                        : stacks.harvestNegatives(cascade, want, seed, config.threads);
+                                        : config.incrementalMining ? miner.harvest(cascade, want, seed, config.threads)
+                                                                   : stacks.harvestNegatives(cascade, want, seed, config.threads);
     const double harvestSeconds = std::chrono::duration<double>(Clock::now() - ts).count();
     if (stage == 1) initialCandidates = std::max<std::size_t>(1, harvest.candidates);
     const double cascadeFa = double(harvest.candidates) / double(initialCandidates);

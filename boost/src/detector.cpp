@@ -2,6 +2,7 @@
 
 #include "integral_grids.h"
 #include "opencv_pyramid.h"
+#include "scalar_scan.h"
 #include "window_scanner.h"
 
 #include <tbb/blocked_range.h>
@@ -19,114 +20,6 @@
 namespace fusedet::boosting {
 
 namespace {
-
-int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
-
-// One stump with its feature laid out for one scale: rectangle corners as offsets from the
-// window's origin in its layer's integral (OpenCV's OptFeature idea), flat for the hot loop.
-// Branch-free form of FeatureLayout (stump types mix unpredictably): black = rect 0 + rect 1
-// (rect 1 is an empty rectangle, sum exactly 0, unless the type has two black parts), white =
-// rect 2 - rest * black with rest = 1 when rect 2 is the outer rectangle, else 0. Same values as
-// featureValue() (adding or subtracting an exact zero changes nothing but the sign of a zero).
-struct ScaledStump {
-  int layer = 0;
-  std::array<std::array<std::int32_t, 4>, 3> ofs{};  // (x0,y0) (x1,y0) (x0,y1) (x1,y1)
-  double rest = 0;
-  double blackArea = 1, whiteArea = 1;
-  float threshold = 0;
-  std::array<double, 2> leaf{};  // left, right: indexed, not branched on
-};
-
-struct ScaledStage {
-  std::size_t begin = 0, end = 0;  // range in the stump array
-  double threshold = 0;
-};
-
-struct ScalePlan {
-  int winW = 0, winH = 0, step = 1;
-  std::vector<int> xs, ys;                       // window positions (reference pixels)
-  std::vector<std::vector<std::ptrdiff_t>> colOfs, rowOfs;  // per layer, per position
-  std::vector<ScaledStump> stumps;
-  std::vector<ScaledStage> stages;
-};
-
-std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, const ScanParams& p) {
-  const int W = in.width(), H = in.height();
-  std::vector<ScalePlan> plans;
-  for (ScaleWindows& win : windowScales(c, W, H, p)) {
-    ScalePlan sp;
-    sp.winW = win.winW;
-    sp.winH = win.winH;
-    sp.step = win.step;
-    sp.xs = std::move(win.xs);
-    sp.ys = std::move(win.ys);
-    const std::size_t nl = in.size();
-    sp.colOfs.resize(nl);
-    sp.rowOfs.resize(nl);
-    std::vector<std::array<int, 2>> lwSize(nl);
-    for (std::size_t l = 0; l < nl; ++l) {
-      const LayerIntegral& li = in.layer(l);
-      lwSize[l] = layerWindowSize(li, W, H, sp.winW, sp.winH);
-      const double sx = double(li.width) / W, sy = double(li.height) / H;
-      for (int x : sp.xs) sp.colOfs[l].push_back(std::clamp(roundHalfUp(x * sx), 0, li.width - lwSize[l][0]));
-      for (int y : sp.ys)
-        sp.rowOfs[l].push_back(std::ptrdiff_t(std::clamp(roundHalfUp(y * sy), 0, li.height - lwSize[l][1])) *
-                               li.stride());
-    }
-    for (const Stage& st : c.stages) {
-      ScaledStage ss{sp.stumps.size(), 0, st.threshold};
-      for (const Stump& t : st.stumps) {
-        const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
-        const auto l = static_cast<std::size_t>(f.layer);
-        const std::ptrdiff_t stride = in.layer(l).stride();
-        const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lwSize[l][0], lwSize[l][1]));
-        ScaledStump z;
-        z.layer = f.layer;
-        z.rest = lay.whiteIsRest ? 1.0 : 0.0;
-        z.blackArea = lay.blackArea;
-        z.whiteArea = lay.whiteArea;
-        auto corners = [stride](const PixelRect& r) {
-          return std::array<std::int32_t, 4>{
-              static_cast<std::int32_t>(r.y0 * stride + r.x0), static_cast<std::int32_t>(r.y0 * stride + r.x1),
-              static_cast<std::int32_t>(r.y1 * stride + r.x0), static_cast<std::int32_t>(r.y1 * stride + r.x1)};
-        };
-        z.ofs[0] = corners(lay.rects[0]);
-        z.ofs[1] = lay.blackCount == 2 ? corners(lay.rects[1]) : std::array<std::int32_t, 4>{0, 0, 0, 0};
-        z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
-        z.threshold = static_cast<float>(t.threshold);
-        z.leaf = {t.left, t.right};
-        sp.stumps.push_back(z);
-      }
-      ss.end = sp.stumps.size();
-      sp.stages.push_back(ss);
-    }
-    plans.push_back(std::move(sp));
-  }
-  return plans;
-}
-
-// The hot loop: same arithmetic, in the same order, as featureValue() + evaluateWindow().
-inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, std::size_t& stumps) {
-  WindowResult r;
-  for (const ScaledStage& st : sp.stages) {
-    double sum = 0;
-    for (std::size_t k = st.begin; k < st.end; ++k) {
-      const ScaledStump& z = sp.stumps[k];
-      const double* p = base[z.layer];
-      auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
-      const double black = rs(z.ofs[0]) + rs(z.ofs[1]);
-      const double white = rs(z.ofs[2]) - z.rest * black;
-      const auto v = static_cast<float>(black / z.blackArea - white / z.whiteArea);
-      sum += z.leaf[static_cast<std::size_t>(!(v < z.threshold))];
-    }
-    stumps += st.end - st.begin;
-    r.score = sum;
-    if (sum < st.threshold) return r;
-    ++r.stagesPassed;
-  }
-  r.accepted = true;
-  return r;
-}
 
 template <class Body>
 void forEachRow(std::size_t rows, int threads, const Body& body) {

@@ -24,16 +24,24 @@ std::vector<std::string> neighbourClasses(const std::string& className) {
   return {};
 }
 
-bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& c) {
+NegativeWindowTest::NegativeWindowTest(const Labels& labels, const SampleConfig& c)
+    : maxIgnoreCoverage_(c.maxIgnoreCoverage), maxNegativeIou_(c.maxNegativeIou) {
   for (const Label& l : labels) {
-    if (isIgnoredLabel(l, c)) {
-      if (coverage(window, l.box) > c.maxIgnoreCoverage || coverage(l.box, window) > c.maxIgnoreCoverage)
-        return false;
-    } else if (l.className == c.className && iou(window, l.box) >= c.maxNegativeIou) {
-      return false;
-    }
+    if (isIgnoredLabel(l, c)) ignored_.push_back(l.box);
+    else if (l.className == c.className) positives_.push_back(l.box);
   }
+}
+
+bool NegativeWindowTest::operator()(const Box& window) const {
+  for (const Box& b : ignored_)
+    if (coverage(window, b) > maxIgnoreCoverage_ || coverage(b, window) > maxIgnoreCoverage_) return false;
+  for (const Box& b : positives_)
+    if (iou(window, b) >= maxNegativeIou_) return false;
   return true;
+}
+
+bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& c) {
+  return NegativeWindowTest(labels, c)(window);
 }
 
 std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double scale, std::mt19937_64& rng) {
@@ -127,9 +135,10 @@ std::vector<Box> TrainingStacks::candidateWindows(const Detector& detector, std:
   ScanStats stats;
   const std::vector<RawHit> hits = detector.scan(integrals_.at(s), params, &stats);
   *scanned += stats.windows;
+  const NegativeWindowTest labelFree(labels_[s], config_);
   std::vector<Box> out;
   for (const RawHit& hit : hits)
-    if (isNegativeWindow(hit.box, labels_[s], config_)) out.push_back(hit.box);
+    if (labelFree(hit.box)) out.push_back(hit.box);
   return out;
 }
 

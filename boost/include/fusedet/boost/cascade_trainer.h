@@ -41,6 +41,11 @@ struct TrainingConfig {
   std::size_t minPositives = 10;      // fewer still-accepted positives end training
   std::uint64_t seed = 1;
   int threads = 0;                    // 0 = all cores
+  // Negative mining: true = incremental (negative_miner.h: each stage evaluates only its new
+  // stage on the windows still accepted), false = every window of every stack rescanned with the
+  // whole cascade (TrainingStacks::harvestNegatives()). Same negatives, same model either way;
+  // false is the reference path the tests compare with.
+  bool incrementalMining = true;
 
   // Throws std::invalid_argument naming the bad setting.
   void validate() const;

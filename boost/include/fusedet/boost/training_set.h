@@ -62,6 +62,18 @@ std::vector<std::string> neighbourClasses(const std::string& className);
 // May `window` of a stack with `labels` serve as a negative?
 bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfig& config);
 
+// isNegativeWindow() for many windows of one stack: the labels sorted once into ignored labels
+// and positives, so a window costs only geometry (negative mining tests every window).
+class NegativeWindowTest {
+ public:
+  NegativeWindowTest(const Labels& labels, const SampleConfig& config);
+  bool operator()(const Box& window) const;
+
+ private:
+  std::vector<Box> ignored_, positives_;
+  double maxIgnoreCoverage_ = 0.5, maxNegativeIou_ = 0.3;
+};
+
 struct NegativeHarvest {
   std::vector<Sample> samples;
   std::size_t windowsScanned = 0;   // all windows the scan visited
@@ -90,6 +102,7 @@ class TrainingStacks {
 
   std::size_t size() const { return integrals_.size(); }
   const IntegralStack& integrals(std::size_t i) const { return integrals_.at(i); }
+  const Labels& labels(std::size_t i) const { return labels_.at(i); }
   // Rank holding stack i (mirrored copies live with their original).
   int owner(std::size_t i) const { return owner_.at(i); }
   const Shard& shard() const { return shard_; }
