@@ -111,6 +111,7 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.readRange("max_clients", c.socket.maxClients, 1, 1024);
     s.readRange("max_request_bytes", c.socket.maxRequestBytes, 64, 1 << 20);
     s.readRange("client_queue", c.socket.clientQueue, 1, 1 << 16);
+    s.readRange("client_send_buffer", c.socket.clientSendBuffer, 0, 1 << 24);
     s.finish();
   }
   {
@@ -232,7 +233,8 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "path" << YAML::Value << c.socket.path;
   out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients;
   out << YAML::Key << "max_request_bytes" << YAML::Value << c.socket.maxRequestBytes;
-  out << YAML::Key << "client_queue" << YAML::Value << c.socket.clientQueue << YAML::EndMap;
+  out << YAML::Key << "client_queue" << YAML::Value << c.socket.clientQueue;
+  out << YAML::Key << "client_send_buffer" << YAML::Value << c.socket.clientSendBuffer << YAML::EndMap;
   out << YAML::Key << "laser" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "device" << YAML::Value << c.laser.device;
   out << YAML::Key << "baud" << YAML::Value << c.laser.baud;

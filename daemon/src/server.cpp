@@ -197,6 +197,9 @@ void Server::accept() {
       ++counters_.refused;
       continue;
     }
+    if (limits.clientSendBuffer > 0 &&
+        ::setsockopt(fd.get(), SOL_SOCKET, SO_SNDBUF, &limits.clientSendBuffer, sizeof limits.clientSendBuffer) < 0)
+      spdlog::warn("server: SO_SNDBUF {}: {}", limits.clientSendBuffer, std::strerror(errno));
     auto c = std::make_unique<Client>();
     c->key = nextKey_++;
     c->fd = std::move(fd);

@@ -29,6 +29,7 @@ ServerLimits serverLimitsFrom(const Config& config) {
   l.maxClients = config.socket.maxClients;
   l.maxRequestBytes = static_cast<std::size_t>(config.socket.maxRequestBytes);
   l.clientQueue = static_cast<std::size_t>(config.socket.clientQueue);
+  l.clientSendBuffer = config.socket.clientSendBuffer;
   return l;
 }
 
@@ -109,6 +110,7 @@ std::string Service::reload(const Config& next) {
   applied.socket.maxClients = next.socket.maxClients;
   applied.socket.maxRequestBytes = next.socket.maxRequestBytes;
   applied.socket.clientQueue = next.socket.clientQueue;
+  applied.socket.clientSendBuffer = next.socket.clientSendBuffer;
   if (dumpConfig(applied) != dumpConfig(next))
     spdlog::warn("reload: changes outside detection, socket limits and log level take effect after a restart");
   config_ = applied;

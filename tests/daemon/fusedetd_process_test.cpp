@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <fstream>
 #include <sstream>
@@ -45,9 +46,9 @@ fs::path tempDir(const std::string& name) {
 std::string model(const std::string& cls) { return std::string(FUSEDET_SOURCE_DIR) + "/models/" + cls + ".json"; }
 
 void writeConfig(const fs::path& file, const std::string& socket, const std::vector<std::string>& classes,
-                 const std::string& extra = "") {
+                 const std::string& extra = "", const std::string& socketExtra = "") {
   std::ofstream out(file);
-  out << "socket:\n  path: " << socket << "\nlaser:\n  device: /nonexistent/fusedet-test-ttyUSB\n"
+  out << "socket:\n  path: " << socket << "\n" << socketExtra << "laser:\n  device: /nonexistent/fusedet-test-ttyUSB\n"
       << "  reconnect_max_s: 0.5\ntilt:\n  interface: fdtestcan9\ncamera:\n  device: /nonexistent/fusedet-test-video\n  calibration: " << FUSEDET_SOURCE_DIR
       << "/tests/daemon/data/camera.yaml\ndetection:\n  models: [";
   for (std::size_t i = 0; i < classes.size(); ++i) out << (i ? ", " : "") << model(classes[i]);
@@ -64,7 +65,8 @@ void writeReplayConfig(const fs::path& file, const std::string& socket, const st
 
 class Process {
  public:
-  Process(std::vector<std::string> argv, std::vector<std::string> env, const fs::path& log) {
+  // stderr goes to `log`; stdout too unless `out` names a file of its own.
+  Process(std::vector<std::string> argv, std::vector<std::string> env, const fs::path& log, const fs::path& out = {}) {
     std::vector<char*> args, envp;
     for (auto& a : argv) args.push_back(a.data());
     args.push_back(nullptr);
@@ -74,6 +76,7 @@ class Process {
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, 2, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (!out.empty()) posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), envp.data()) != 0) pid_ = -1;
     posix_spawn_file_actions_destroy(&fa);
   }
@@ -395,6 +398,176 @@ TEST(Fusedetd, AStuckDetectionThreadWithholdsWatchdogAndStatusSaysSo) {
   std::this_thread::sleep_for(1500ms);
   EXPECT_GE(notify.count("WATCHDOG=1"), 3);
   EXPECT_NE(readFile(dir / "log").find("watchdog: detection thread stuck for"), std::string::npos);
+  ::kill(daemon.pid(), SIGTERM);
+  EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+}
+
+// A subscriber that never reads, on a daemon replaying as fast as the pipeline goes (lossless,
+// looping): the detection lines fill its kernel buffer (socket.client_send_buffer 4096) and then
+// its queue (socket.client_queue 8), and it is dropped - by detection lines alone, it asked for
+// nothing else. A client that reads gets every stack in order without a gap, before and well
+// after the drop, and the pipeline goes on. Asserts on counts and sequence numbers only.
+TEST(Fusedetd, ASilentSubscriberIsDroppedOnDetectionLinesAndAReaderGetsEveryStack) {
+  const fs::path dir = tempDir("silent");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
+  // Bundled models on windows of 300 px and up only, so that a stack is quick to detect and the
+  // lines come as fast as the log is read.
+  writeConfig(config, socket, {"car", "bike", "person"},
+              "  min_size: [300, 300]\n  threads: 1\nreplay:\n  file: " + fusedet::testlogs::daemonTestLog(3).string() +
+                  "\n  realtime: false\n  at_end: loop\n",
+              "  client_queue: 8\n  client_send_buffer: 4096\n");
+  Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
+  std::unique_ptr<Client> silent;
+  for (int i = 0; i < 1200 && !silent; ++i) {  // the socket is bound before the replay starts
+    try {
+      silent = std::make_unique<Client>(socket.string());
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  ASSERT_TRUE(silent) << readFile(dir / "log");
+  silent->send({{"cmd", "subscribe"}});
+  Client reader(socket.string()), asker(socket.string());
+  reader.send({{"cmd", "subscribe"}});
+
+  // Read until the silent client is gone and 12 more stacks arrived (a generous cap, in stacks).
+  std::vector<nlohmann::json> got;
+  std::optional<std::uint64_t> droppedBy;  // the reader's newest stack when the drop was seen
+  while (got.size() < 400) {
+    const auto m = reader.read(60s);
+    ASSERT_TRUE(m) << "the reader got nothing for 60 s (closed: " << reader.closed() << ")\n" << readFile(dir / "log");
+    if ((*m)["type"] != "detections") continue;
+    got.push_back(*m);
+    if (!droppedBy && ask(asker, "status")["clients"]["dropped_slow"] == 1) droppedBy = (*m)["stack"].get<std::uint64_t>();
+    if (droppedBy && (*m)["stack"].get<std::uint64_t>() >= *droppedBy + 12) break;
+  }
+  ASSERT_TRUE(droppedBy) << "the silent client was not dropped within " << got.size() << " stacks";
+  // Every stack, in order, no gap (sequence numbers count every fused stack).
+  for (std::size_t i = 1; i < got.size(); ++i) ASSERT_EQ(got[i]["stack"], got[i - 1]["stack"].get<std::uint64_t>() + 1);
+
+  const auto status = ask(asker, "status");
+  EXPECT_EQ(status["clients"]["dropped_slow"], 1) << status.dump();
+  EXPECT_EQ(status["clients"]["disconnected"], 0) << status.dump();
+  EXPECT_EQ(status["clients"]["connected"], 2) << status.dump();
+  EXPECT_EQ(status["pipeline"]["stack_queue"]["dropped"], 0);
+  EXPECT_EQ(status["pipeline"]["sensor_queue"]["dropped"], 0);
+  EXPECT_EQ(status["pipeline"]["detect_errors"], 0);
+  EXPECT_GE(status["pipeline"]["stacks_detected"].get<std::uint64_t>(), got.back()["stack"].get<std::uint64_t>());
+
+  // What the silent client finally reads: its reply, then the lines the kernel held for it -
+  // the same lines the reader got, without a gap - and then the end of the connection.
+  const auto subscribed = silent->read(10s);
+  ASSERT_TRUE(subscribed);
+  EXPECT_EQ((*subscribed)["type"], "subscribed");
+  std::vector<nlohmann::json> held;
+  while (auto m = silent->read(10s)) held.push_back(*m);
+  EXPECT_TRUE(silent->closed());
+  ASSERT_FALSE(held.empty());
+  EXPECT_LE(held.size(), 16u) << "more lines than a 4096-byte send buffer holds (the default holds ~170)";
+  std::map<std::uint64_t, nlohmann::json> byStack;
+  for (const auto& l : got) byStack[l["stack"].get<std::uint64_t>()] = l;
+  for (std::size_t i = 0; i < held.size(); ++i) {
+    if (i) {
+      EXPECT_EQ(held[i]["stack"], held[i - 1]["stack"].get<std::uint64_t>() + 1);
+    }
+    const auto stack = held[i]["stack"].get<std::uint64_t>();
+    if (byStack.count(stack)) {
+      EXPECT_EQ(held[i], byStack[stack]);
+    }
+  }
+  // Dropped when its queue overflowed: client_queue (8) lines after the last one it holds.
+  EXPECT_LE(held.back()["stack"].get<std::uint64_t>() + 8, *droppedBy);
+  std::printf("silent client: held %zu lines (stacks %s..%s), drop seen at stack %llu; reader: stacks %s..%s, no gap\n",
+              held.size(), held.front()["stack"].dump().c_str(), held.back()["stack"].dump().c_str(),
+              static_cast<unsigned long long>(*droppedBy), got.front()["stack"].dump().c_str(), got.back()["stack"].dump().c_str());
+
+  ::kill(daemon.pid(), SIGTERM);
+  EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
+}
+
+// `fusedet query`, the client of the issue, against a replaying daemon: `--follow --class car
+// --class person --count 4` prints the hello, the subscription and four consecutive stacks carrying exactly the car
+// and person detections an unfiltered subscriber got for the same stacks; `--status`, `--hello`
+// and no option (the latest stack) print one reply each; an absent socket is exit 1.
+TEST(Fusedetd, QueryFollowsClassesAndPrintsStatusHelloAndLatest) {
+  const fs::path dir = tempDir("query");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
+  writeReplayConfig(config, socket, {"car", "bike", "person"}, "loop", false);
+  Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
+  std::unique_ptr<Client> all;
+  for (int i = 0; i < 1200 && !all; ++i) {
+    try {
+      all = std::make_unique<Client>(socket.string());
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  ASSERT_TRUE(all) << readFile(dir / "log");
+  all->send({{"cmd", "subscribe"}});
+  ASSERT_TRUE(all->read(10s));  // "subscribed": from here on it gets every stack
+  const std::string query = std::string(FUSEDET_BINARY_DIR) + "/tools/fusedet";
+  Process follow({query, "query", "--socket", socket.string(), "--follow", "--class", "car", "--class", "person", "--count",
+                  "4", "--timeout", "120"},
+                 {}, dir / "follow.err", dir / "follow.out");
+  EXPECT_EQ(follow.wait(300s), 0) << readFile(dir / "follow.err");
+  std::vector<nlohmann::json> printed;
+  {
+    std::ifstream in(dir / "follow.out");
+    for (std::string line; std::getline(in, line);) printed.push_back(nlohmann::json::parse(line));
+  }
+  ASSERT_EQ(printed.size(), 6u) << readFile(dir / "follow.out");
+  EXPECT_EQ(printed[0]["type"], "hello");
+  EXPECT_EQ(printed[0]["classes"], nlohmann::json({"car", "bike", "person"}));
+  EXPECT_EQ(printed[1], nlohmann::json({{"type", "subscribed"}, {"classes", nlohmann::json::array({"car", "person"})}}));
+  printed.erase(printed.begin());  // from here: [1..4] are the detections lines
+  // The unfiltered subscriber's lines for the same stacks (it subscribed first).
+  const auto last = printed.back()["stack"].get<std::uint64_t>();
+  std::map<std::uint64_t, nlohmann::json> reference;
+  while (reference.empty() || reference.rbegin()->first < last) {
+    const auto m = all->read(120s);
+    ASSERT_TRUE(m) << "the unfiltered subscriber stopped receiving";
+    if ((*m)["type"] == "detections") reference[(*m)["stack"].get<std::uint64_t>()] = *m;
+  }
+  std::size_t kept = 0, left = 0;
+  for (std::size_t i = 1; i < printed.size(); ++i) {
+    const auto& line = printed[i];
+    ASSERT_EQ(line["type"], "detections") << line.dump();
+    if (i > 1) {
+      EXPECT_EQ(line["stack"], printed[i - 1]["stack"].get<std::uint64_t>() + 1);
+    }
+    ASSERT_TRUE(reference.count(line["stack"].get<std::uint64_t>())) << line.dump();
+    const auto& ref = reference[line["stack"].get<std::uint64_t>()];
+    nlohmann::json expected = nlohmann::json::array();
+    for (const auto& d : ref["detections"]) {
+      if (d["class"] == "car" || d["class"] == "person") expected.push_back(d);
+      else ++left;
+    }
+    kept += expected.size();
+    EXPECT_EQ(line["detections"], expected) << "stack " << line["stack"];
+    EXPECT_EQ(line["sweep_start_ns"], ref["sweep_start_ns"]);
+    EXPECT_EQ(line["frame_ns"], ref["frame_ns"]);
+  }
+  std::printf("query --class car --class person: %zu detections kept, %zu of other classes left out\n", kept, left);
+
+  auto one = [&](const std::vector<std::string>& args, const std::string& name) {
+    std::vector<std::string> argv{query, "query", "--socket", socket.string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    Process p(argv, {}, dir / (name + ".err"), dir / (name + ".out"));
+    EXPECT_EQ(p.wait(120s), 0) << readFile(dir / (name + ".err"));
+    return nlohmann::json::parse(readFile(dir / (name + ".out")));
+  };
+  const auto status = one({"--status"}, "status");
+  EXPECT_EQ(status["type"], "status");
+  EXPECT_EQ(status["sensors"][0]["name"], "replay");
+  EXPECT_GT(status["pipeline"]["stacks_detected"].get<std::uint64_t>(), last);
+  EXPECT_EQ(one({"--hello"}, "hello")["mode"], "replay");
+  const auto latest = one({}, "latest");
+  EXPECT_EQ(latest["type"], "latest");
+  EXPECT_GE(latest["stack"].get<std::uint64_t>(), last);
+
+  Process absent({query, "query", "--socket", (dir / "absent.sock").string()}, {}, dir / "absent.err", dir / "absent.out");
+  EXPECT_EQ(absent.wait(60s), 1);
+  EXPECT_NE(readFile(dir / "absent.err").find("absent.sock"), std::string::npos) << readFile(dir / "absent.err");
   ::kill(daemon.pid(), SIGTERM);
   EXPECT_EQ(daemon.wait(5s), 0) << readFile(dir / "log");
 }

@@ -25,6 +25,7 @@ struct Config {
     int maxClients = 16;
     int maxRequestBytes = 4096;
     int clientQueue = 256;
+    int clientSendBuffer = 0;  // bytes (SO_SNDBUF) per client connection; 0 = the system default
   } socket;
 
   struct Laser {

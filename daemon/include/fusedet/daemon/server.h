@@ -26,6 +26,10 @@ struct ServerLimits {
   int maxClients = 16;
   std::size_t maxRequestBytes = 4096;  // one request line, without its newline
   std::size_t clientQueue = 256;       // lines queued for one client before it is dropped
+  // Kernel send buffer of each client connection (SO_SNDBUF; the kernel doubles it, minimum
+  // ~4.6 KB); 0 = the system default (net.core.wmem_default, ~200 KB = ~170 lines). Lines in it
+  // are out of the server's queue: a client is dropped after buffer + clientQueue lines unread.
+  int clientSendBuffer = 0;
 };
 
 struct ServerCounters {
