@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 namespace fusedet::daemon {
 namespace {
 
@@ -44,18 +46,22 @@ void ReplaySource::record(const drivers::logs::SensorReplayCounters& counters) {
 
 void ReplaySource::run(SensorSink& sink) {
   std::uint64_t delivered = 0;
+  std::int64_t newest = 0;  // newest stamp delivered: the next pass is stamped after it
   drivers::logs::SensorReplay::Handlers h;
   h.scan = [&](const drivers::LaserScan& s) {
     sink.onScan(s);
     ++delivered;
+    newest = std::max(newest, s.stamp.ns);
   };
   h.tilt = [&](const drivers::TiltSample& t) {
     sink.onTilt(t);
     ++delivered;
+    newest = std::max(newest, t.stamp.ns);
   };
   h.frame = [&](const drivers::CameraFrame& f) {
     sink.onFrame(f);
     ++delivered;
+    newest = std::max(newest, f.stamp.ns);
   };
   for (;;) {
     for (;;) {
@@ -79,6 +85,9 @@ void ReplaySource::run(SensorSink& sink) {
     }
     spdlog::info("replay {}: end of log (pass {})", settings_.log.string(), passes_);
     if (!settings_.loop) break;
+    // Faster than the clock, a pass restamped to "now" would go back in time behind the last one
+    // (sweeps cut short at the seam, frames left unpaired): continue after its newest stamp.
+    options_.restampFromNs = newest + 50'000'000;  // past the last scan's beams (13 ms at 75 Hz)
     try {
       replay_ = std::make_unique<drivers::logs::SensorReplay>(settings_.log, settings_.sensors, options_);
     } catch (const std::exception& e) {

@@ -41,6 +41,7 @@ Service::Service(ServiceParts parts)
     : config_(std::move(parts.config)),
       configFile_(std::move(parts.configFile)),
       mode_(std::move(parts.mode)),
+      wallClockStamps_(parts.wallClockStamps),
       sources_(std::move(parts.sources)) {
   Server::Handlers handlers{[this] { return hello(); }, [this] { return status(); }};
   server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
@@ -130,7 +131,9 @@ nlohmann::json Service::status() const {
   const std::int64_t now = Stamp::now().ns;
   const PipelineCounters p = pipeline_->counters();
   const ServerCounters s = server_->counters();
-  const LatencySummary lat = server_->latency();
+  // Stamps ahead of the clock (as fast as possible, speed > 1) or in the past (not re-stamped)
+  // would give meaningless, even negative, latencies: none is reported then.
+  const LatencySummary lat = wallClockStamps_ ? server_->latency() : LatencySummary{};
   nlohmann::json sensors = nlohmann::json::array();
   for (const auto& src : sources_)
     for (const SensorHealth& h : src->health()) {

@@ -54,6 +54,7 @@ ServiceParts replayParts(Config config, const std::filesystem::path& configFile)
   }
   parts.sensorConfig = std::move(rig.config);
   parts.lossless = !config.replay.realtime;
+  parts.wallClockStamps = config.replay.realtime && config.replay.speed == 1.0 && config.replay.restamp;
   parts.configFile = configFile;
   parts.config = std::move(config);
   parts.mode = "replay";

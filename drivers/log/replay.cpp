@@ -1,5 +1,6 @@
 #include "fusedet/drivers/log/replay.h"
 
+#include <algorithm>
 #include <thread>
 
 #include "fusedet/drivers/lms291/link.h"
@@ -24,7 +25,7 @@ bool LogSource::waitUntilDue(std::uint64_t logTime, const std::atomic<bool>* sto
   if (!firstLogTime_) {
     firstLogTime_ = logTime;
     wallStart_ = std::chrono::steady_clock::now();
-    if (options_.restamp) shiftNs_ = Stamp::now().ns - static_cast<std::int64_t>(logTime);
+    if (options_.restamp) shiftNs_ = std::max(Stamp::now().ns, options_.restampFromNs) - static_cast<std::int64_t>(logTime);
   }
   if (!options_.realtime) return !(stop && stop->load());
   const double offsetS = static_cast<double>(logTime - *firstLogTime_) * 1e-9 / std::max(options_.speed, 1e-6);

@@ -282,6 +282,14 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
   EXPECT_EQ(status["clients"]["oversized_requests"], 3);
   EXPECT_EQ(status["pipeline"]["stack_queue"]["dropped"], 0);
   EXPECT_GE(status["sensors"][0]["passes"].get<int>(), 2);
+  // Looping faster than recorded: each pass is stamped after the last, so every stroke of every
+  // pass is a whole sweep paired with its frame (a pass restamped to "now" went back in time:
+  // sweeps cut at the seam, frames unpaired, scans without tilt).
+  EXPECT_EQ(status["pipeline"]["unpaired_sweeps"], 0) << status.dump();
+  EXPECT_EQ(status["pipeline"]["scans_dropped_no_tilt"], 0) << status.dump();
+  EXPECT_GE(status["pipeline"]["stacks_fused"].get<int>(), kStrokes * status["sensors"][0]["passes"].get<int>());
+  // Stamps ahead of the clock are no latency: none is reported (it was negative).
+  EXPECT_EQ(status["latency_ms"]["samples"], 0) << status.dump();
   for (auto& s : silent) {
     while (s->readLine(5s)) {
     }

@@ -189,6 +189,16 @@ TEST(Replay, RestampShiftsEverythingByOneOffset) {
   const std::int64_t shift = b.scans[0].stamp - a.scans[0].stamp;
   EXPECT_GT(b.scans[0].stamp.ns, Stamp::now().ns - 60'000'000'000);
   for (std::size_t i = 0; i < a.scans.size(); ++i) EXPECT_EQ(b.scans[i].stamp - a.scans[i].stamp, shift);
+
+  // restampFromNs later than now (a looping replay's next pass): the same offsets, starting there.
+  o.restampFromNs = Stamp::now().ns + 3'600'000'000'000;
+  const Collected c = replayAll(s.path, o);
+  ASSERT_EQ(a.scans.size(), c.scans.size());
+  const std::int64_t later = c.scans[0].stamp - a.scans[0].stamp;
+  // The log's first message (its time) is stamped restampFromNs; the first scan lies within a second of it.
+  EXPECT_NEAR(static_cast<double>(c.scans[0].stamp.ns - o.restampFromNs), 0.0, 1e9);
+  EXPECT_GT(later, shift + 3'500'000'000'000);
+  for (std::size_t i = 0; i < a.scans.size(); ++i) EXPECT_EQ(c.scans[i].stamp - a.scans[i].stamp, later);
 }
 
 TEST(Replay, CutLogReplaysItsCompleteChunks) {

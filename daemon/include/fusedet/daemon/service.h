@@ -33,6 +33,9 @@ struct ServiceParts {
   // (replay: the log's rig, rig.h replayRig).
   std::optional<Config> sensorConfig;
   bool lossless = false;  // PipelineSetup::lossless (a log replayed as fast as possible)
+  // Sensor stamps are the clock's "now" as data arrives (live, or a replay paced at speed 1 and
+  // re-stamped): only then is sensor stamp -> client a latency (status latency_ms).
+  bool wallClockStamps = true;
 };
 
 // Fusion settings (camera calibration file, extrinsics, laser layers) of a config; a relative
@@ -86,6 +89,7 @@ class Service {
   Config config_;
   std::filesystem::path configFile_;
   std::string mode_;
+  bool wallClockStamps_ = true;
   std::string lastReloadError_;
   std::uint64_t reloads_ = 0;
   std::vector<std::unique_ptr<Source>> sources_;

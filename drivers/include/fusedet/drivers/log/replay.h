@@ -34,6 +34,10 @@ struct ReplayOptions {
   // Shift every stamp by (Stamp::now() at the first message - its log time), so replayed data
   // looks live (latency measurements). Breaks bit-for-bit determinism of stamps only.
   bool restamp = false;
+  // With restamp: the first message is stamped no earlier than this (CLOCK_MONOTONIC ns), so a
+  // looping replay's next pass continues after the previous one although that ran ahead of the
+  // clock (as fast as possible, or speed > 1). 0 = now.
+  std::int64_t restampFromNs = 0;
 };
 
 struct ReplayCounters {
