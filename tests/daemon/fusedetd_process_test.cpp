@@ -250,6 +250,9 @@ TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
   EXPECT_EQ(status["clients"]["dropped_slow"], 0);
   EXPECT_EQ(status["sensors"][0]["name"], "replay");
   EXPECT_GT(status["pipeline"]["stacks_detected"].get<int>(), 0);
+  // Paced like the recording and re-stamped: sensor stamp -> client is a real latency.
+  EXPECT_GT(status["latency_ms"]["samples"].get<int>(), 0) << status.dump();
+  EXPECT_GT(status["latency_ms"]["p50"].get<double>(), 0.0) << status.dump();
 
   const auto t0 = std::chrono::steady_clock::now();
   ::kill(daemon.pid(), SIGTERM);
@@ -364,6 +367,35 @@ void writeSlowModel(const fs::path& file) {
   out << R"({"threshold": 1e9, "stumps": [{"type": "b", "rect": [0, 0, 0.5, 0.5], "layer": "intensity", "threshold": 0, "left": 1, "right": 1}]}]})";
 }
 }  // namespace
+
+// SIGTERM while the detection thread is inside a slow stack (a cascade cannot be interrupted):
+// fusedetd still exits 0 within 2 s, saying it did not wait for the stack.
+TEST(Fusedetd, SigtermWhileDetectionIsInsideASlowStackExits0Within2s) {
+  const fs::path dir = tempDir("term-stuck");
+  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock", slow = dir / "slow.json";
+  writeSlowModel(slow);
+  writeConfig(config, socket, {"car"},
+              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(1).string() + "\n  at_end: idle\n");
+  {
+    std::string text = readFile(config);
+    const auto at = text.find("  models: [");
+    text.replace(at, text.find('\n', at) - at, "  models: [" + slow.string() + "]\n  threads: 1");
+    std::ofstream(config) << text;
+  }
+  NotifySocket notify(dir / "notify");
+  Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=1000000"}, dir / "log");
+  ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
+  ASSERT_TRUE(notify.waitFor("detection thread stuck for 1 s", 120s)) << readFile(dir / "log");
+  const auto t0 = std::chrono::steady_clock::now();
+  ::kill(daemon.pid(), SIGTERM);
+  const int rc = daemon.wait(10s);
+  const auto took = std::chrono::steady_clock::now() - t0;
+  EXPECT_EQ(rc, 0) << readFile(dir / "log");
+  EXPECT_LT(took, 2s) << std::chrono::duration_cast<std::chrono::milliseconds>(took).count() << " ms";
+  EXPECT_NE(readFile(dir / "log").find("exiting without it"), std::string::npos) << readFile(dir / "log");
+  std::printf("SIGTERM inside a slow stack: exit %d after %lld ms\n", rc,
+              static_cast<long long>(std::chrono::duration_cast<std::chrono::milliseconds>(took).count()));
+}
 
 // A detection thread stuck in one stack withholds WATCHDOG=1 (systemd would restart the service
 // after WatchdogSec) and STATUS= names it; when the stack is done the pings resume and STATUS= no
@@ -560,6 +592,17 @@ TEST(Fusedetd, QueryFollowsClassesAndPrintsStatusHelloAndLatest) {
   EXPECT_EQ(status["type"], "status");
   EXPECT_EQ(status["sensors"][0]["name"], "replay");
   EXPECT_GT(status["pipeline"]["stacks_detected"].get<std::uint64_t>(), last);
+  // Every field docs/protocol.md lists: per-sensor state and counters, rates, drops, latency, uptime.
+  EXPECT_GT(status["uptime_s"].get<double>(), 0.0);
+  for (const char* key : {"state", "messages", "crc_errors", "reconnects", "lost", "last_error", "progress", "passes"})
+    EXPECT_TRUE(status["sensors"][0].contains(key)) << key;
+  EXPECT_EQ(status["sensors"][0]["state"], "replaying");
+  for (const char* rate : {"scans", "tilt", "frames"}) EXPECT_GT(status["rates_hz"][rate].get<double>(), 0.0) << rate;
+  for (const char* queue : {"sensor_queue", "stack_queue"})
+    for (const char* key : {"depth", "pushed", "dropped"}) EXPECT_TRUE(status["pipeline"][queue].contains(key)) << queue << key;
+  for (const char* key : {"samples", "p50", "p90", "p99", "max"}) EXPECT_TRUE(status["latency_ms"].contains(key)) << key;
+  for (const char* key : {"connected", "accepted", "refused", "dropped_slow", "disconnected", "bad_requests", "oversized_requests"})
+    EXPECT_TRUE(status["clients"].contains(key)) << key;
   EXPECT_EQ(one({"--hello"}, "hello")["mode"], "replay");
   const auto latest = one({}, "latest");
   EXPECT_EQ(latest["type"], "latest");

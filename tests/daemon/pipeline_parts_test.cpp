@@ -6,6 +6,7 @@
 #include <random>
 
 #include "fusedet/daemon/bounded_queue.h"
+#include "fusedet/daemon/config.h"
 #include "fusedet/daemon/localize.h"
 #include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/stack_detector.h"
@@ -130,6 +131,29 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   EXPECT_EQ(g.method, glib.method);
   EXPECT_EQ(g.minNeighbors, glib.minNeighbors);
   EXPECT_EQ(g.iouThreshold, glib.iouThreshold);
+}
+
+// Non-default values written in fusedet.yaml reach the library unchanged, in its units: step in
+// base-window pixels (not a fraction of the window), sizes in reference pixels, grouping by name.
+TEST(DetectionSettings, YamlKeysMeanWhatTheLibraryMeans) {
+  const Config c = parseConfig(
+      "detection:\n  step: 3\n  scale_factor: 1.25\n  min_size: [30, 60]\n  max_size: [300, 400]\n"
+      "  grouping: nms\n  nms_iou: 0.3\n  min_neighbors: 5\n  threads: 1\n",
+      "test.yaml");
+  const boosting::ScanParams s = scanParamsFrom(c.detection);
+  EXPECT_EQ(s.step, 3.0);
+  EXPECT_EQ(s.scaleFactor, 1.25);
+  EXPECT_EQ(s.minWidth, 30);
+  EXPECT_EQ(s.minHeight, 60);
+  EXPECT_EQ(s.maxWidth, 300);
+  EXPECT_EQ(s.maxHeight, 400);
+  EXPECT_EQ(s.threads, 1);
+  const boosting::GroupParams g = groupParamsFrom(c.detection);
+  EXPECT_EQ(g.method, boosting::GroupParams::Method::kNms);
+  EXPECT_EQ(g.iouThreshold, 0.3);
+  EXPECT_EQ(g.minNeighbors, 5);
+  EXPECT_EQ(groupParamsFrom(parseConfig("detection:\n  grouping: opencv\n", "t.yaml").detection).method,
+            boosting::GroupParams::Method::kOpenCv);
 }
 
 // A 200 x 100 image, laser layers at half size: background at 20 m, an object at 5 m covering
