@@ -180,6 +180,19 @@ std::string readFile(const fs::path& p) {
   return text.str();
 }
 
+// A client of a daemon just started (the socket is bound before the replay starts), or null
+// after a minute.
+std::unique_ptr<Client> connectOnceBound(const fs::path& socket) {
+  for (int i = 0; i < 1200; ++i) {
+    try {
+      return std::make_unique<Client>(socket.string());
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  return nullptr;
+}
+
 nlohmann::json ask(Client& c, const std::string& cmd) {
   c.send({{"cmd", cmd}});
   auto r = c.read(10s);
@@ -304,14 +317,7 @@ TEST(Fusedetd, ReplayAtEndExitDeliversEveryStackThenExits0) {
   const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
   writeReplayConfig(config, socket, {"car", "bike", "person"}, "exit");
   Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
-  std::unique_ptr<Client> client;
-  for (int i = 0; i < 1200 && !client; ++i) {  // the socket is bound before the replay starts
-    try {
-      client = std::make_unique<Client>(socket.string());
-    } catch (const std::exception&) {
-      std::this_thread::sleep_for(50ms);
-    }
-  }
+  const auto client = connectOnceBound(socket);
   ASSERT_TRUE(client) << readFile(dir / "log");
   client->send({{"cmd", "subscribe"}});
   std::vector<std::uint64_t> stacks;
@@ -366,24 +372,28 @@ void writeSlowModel(const fs::path& file) {
   }
   out << R"({"threshold": 1e9, "stumps": [{"type": "b", "rect": [0, 0, 0.5, 0.5], "layer": "intensity", "threshold": 0, "left": 1, "right": 1}]}]})";
 }
+
+// fusedetd replaying the one-stroke log (then idle) with only that slow model, detection on one
+// thread, WATCHDOG_USEC 1 s: a ping every 250 ms while every thread showed life within 500 ms.
+Process startSlowDetectionDaemon(const fs::path& dir, const NotifySocket& notify) {
+  const fs::path config = dir / "fusedet.yaml";
+  writeSlowModel(dir / "slow.json");
+  writeConfig(config, dir / "fusedet.sock", {"car"},
+              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(1).string() + "\n  at_end: idle\n");
+  std::string text = readFile(config);
+  const auto at = text.find("  models: [");
+  text.replace(at, text.find('\n', at) - at, "  models: [" + (dir / "slow.json").string() + "]\n  threads: 1");
+  std::ofstream(config) << text;
+  return Process({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=1000000"}, dir / "log");
+}
 }  // namespace
 
 // SIGTERM while the detection thread is inside a slow stack (a cascade cannot be interrupted):
 // fusedetd still exits 0 within 2 s, saying it did not wait for the stack.
 TEST(Fusedetd, SigtermWhileDetectionIsInsideASlowStackExits0Within2s) {
   const fs::path dir = tempDir("term-stuck");
-  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock", slow = dir / "slow.json";
-  writeSlowModel(slow);
-  writeConfig(config, socket, {"car"},
-              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(1).string() + "\n  at_end: idle\n");
-  {
-    std::string text = readFile(config);
-    const auto at = text.find("  models: [");
-    text.replace(at, text.find('\n', at) - at, "  models: [" + slow.string() + "]\n  threads: 1");
-    std::ofstream(config) << text;
-  }
   NotifySocket notify(dir / "notify");
-  Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=1000000"}, dir / "log");
+  Process daemon = startSlowDetectionDaemon(dir, notify);
   ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
   ASSERT_TRUE(notify.waitFor("detection thread stuck for 1 s", 120s)) << readFile(dir / "log");
   const auto t0 = std::chrono::steady_clock::now();
@@ -402,19 +412,8 @@ TEST(Fusedetd, SigtermWhileDetectionIsInsideASlowStackExits0Within2s) {
 // longer says stuck. One stack only (a one-stroke log, then idle), so the cost is one slow stack.
 TEST(Fusedetd, AStuckDetectionThreadWithholdsWatchdogAndStatusSaysSo) {
   const fs::path dir = tempDir("stuck");
-  const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock", slow = dir / "slow.json";
-  writeSlowModel(slow);
-  writeConfig(config, socket, {"car"},
-              "replay:\n  file: " + fusedet::testlogs::daemonTestLog(1).string() + "\n  at_end: idle\n");
-  {
-    std::string text = readFile(config);
-    const auto at = text.find("  models: [");
-    text.replace(at, text.find('\n', at) - at, "  models: [" + slow.string() + "]\n  threads: 1");
-    std::ofstream(config) << text;
-  }
   NotifySocket notify(dir / "notify");
-  // WATCHDOG_USEC 1 s: a ping every 250 ms while every thread showed life within 500 ms.
-  Process daemon({kDaemon, "--config", config.string()}, {notify.env(), "WATCHDOG_USEC=1000000"}, dir / "log");
+  Process daemon = startSlowDetectionDaemon(dir, notify);
   ASSERT_TRUE(notify.waitFor("READY=1", 60s)) << readFile(dir / "log");
   // STATUS= names the stuck thread and how long (whole seconds); no ping while it is stuck.
   ASSERT_TRUE(notify.waitFor("detection thread stuck for 1 s", 120s)) << readFile(dir / "log");
@@ -449,14 +448,7 @@ TEST(Fusedetd, ASilentSubscriberIsDroppedOnDetectionLinesAndAReaderGetsEveryStac
                   "\n  realtime: false\n  at_end: loop\n",
               "  client_queue: 8\n  client_send_buffer: 4096\n");
   Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
-  std::unique_ptr<Client> silent;
-  for (int i = 0; i < 1200 && !silent; ++i) {  // the socket is bound before the replay starts
-    try {
-      silent = std::make_unique<Client>(socket.string());
-    } catch (const std::exception&) {
-      std::this_thread::sleep_for(50ms);
-    }
-  }
+  const auto silent = connectOnceBound(socket);
   ASSERT_TRUE(silent) << readFile(dir / "log");
   silent->send({{"cmd", "subscribe"}});
   Client reader(socket.string()), asker(socket.string());
@@ -526,14 +518,7 @@ TEST(Fusedetd, QueryFollowsClassesAndPrintsStatusHelloAndLatest) {
   const fs::path config = dir / "fusedet.yaml", socket = dir / "fusedet.sock";
   writeReplayConfig(config, socket, {"car", "bike", "person"}, "loop", false);
   Process daemon({kDaemon, "--config", config.string()}, {}, dir / "log");
-  std::unique_ptr<Client> all;
-  for (int i = 0; i < 1200 && !all; ++i) {
-    try {
-      all = std::make_unique<Client>(socket.string());
-    } catch (const std::exception&) {
-      std::this_thread::sleep_for(50ms);
-    }
-  }
+  const auto all = connectOnceBound(socket);
   ASSERT_TRUE(all) << readFile(dir / "log");
   all->send({{"cmd", "subscribe"}});
   ASSERT_TRUE(all->read(10s));  // "subscribed": from here on it gets every stack
