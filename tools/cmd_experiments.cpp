@@ -63,6 +63,7 @@ struct ExperimentOptions {
   double step = 0;
   int minNeighbors = 3;
   std::size_t minPositives = 4;
+  std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   std::string commandLine;
 };
 
@@ -210,6 +211,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const Preset
   c.pool.grid = p.grid;
   c.pool.layers = tc.layers;
   c.pool.types = boosting::parseFeatureTypes(tc.types);
+  c.pool.contrastNormalised = boosting::parseContrastNormalised(o.contrastNormalise, tc.layers, true);
   c.samples.className = cls;
   c.samples.minPositiveHeight = match.minHeight;
   c.samples.maxOcclusion = match.maxOcclusion;
@@ -322,6 +324,11 @@ int runExperiments(ExperimentOptions o) {
   const Preset preset = presetFor(o);
   for (const std::string& c : o.configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
+  {  // a layer no configuration has is a typo
+    std::vector<std::string> known;
+    for (const TrainedConfig& t : trainedConfigs()) known.insert(known.end(), t.layers.begin(), t.layers.end());
+    boosting::parseContrastNormalised(o.contrastNormalise, known);
+  }
   const fs::path cache = o.modelCache.empty() ? o.out / "fold-models" : o.modelCache;
   boosting::BootstrapConfig boot;
   boot.resamples = preset.resamples;
@@ -393,6 +400,7 @@ int runExperiments(ExperimentOptions o) {
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
       {"training scan scale factor / step", shortNum(preset.trainScaleFactor) + " / " + shortNum(preset.trainStep)},
       {"grouping", "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors)},
+      {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"fold model cache", cache.string()},
   };
@@ -700,6 +708,11 @@ const bool registered = registerCommand(
       app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.2, quick 1.3)");
       app.add_option("--step", o->step, "detection position step in base-window pixels (default: 3, quick 4)");
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
+      app.add_option("--contrast-normalise", o->contrastNormalise,
+                     "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
+                     "window's standard deviation of their layer): none, camera (red, green, blue, intensity "
+                     "where a configuration has them) or layer names (each configuration normalises those it has)")
+          ->capture_default_str();
       app.add_option("--min-positives", o->minPositives,
                      "training ends when fewer positives than this are still accepted (person data is scarce)")
           ->capture_default_str();

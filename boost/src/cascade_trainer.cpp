@@ -85,7 +85,8 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                  : classReferenceHue(train, config.samples);
   report.referenceHue = refHue;
 
-  const TrainingStacks stacks(train, layers, refHue, config.samples, shard);
+  const std::vector<bool> normalised = config.pool.contrastFlags();
+  const TrainingStacks stacks(train, layers, refHue, config.samples, shard, normalised);
   report.positives = stacks.positives().size();
   if (stacks.positives().empty())
     throw std::runtime_error("no positives of class '" + config.className + "' in " +
@@ -96,6 +97,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   Cascade cascade;
   cascade.className = config.className;
   cascade.layers = layers;
+  cascade.contrastNormalised = normalised;
   cascade.referenceHue = refHue;
   cascade.windowHeight = config.samples.baseWindowHeight;
   cascade.windowWidth = std::max(
@@ -117,6 +119,9 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                 std::to_string(stacks.originalStacks()) + " stacks" +
                 (config.samples.flipPositives ? ", mirrored copies included" : "") + "), window " +
                 std::to_string(cascade.windowWidth) + "x" + std::to_string(cascade.windowHeight) +
+                (config.pool.contrastNormalised.empty()
+                     ? std::string()
+                     : ", contrast-normalised " + std::to_string(config.pool.contrastNormalised.size()) + " layers") +
                 (refHue ? ", reference hue " + fixed(*refHue, 0) + " deg" : std::string()) + ", " +
                 std::to_string(wanted) + " negatives per stage";
     progress.onProgress(e);

@@ -60,12 +60,19 @@ LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data, bool 
 }
 
 IntegralStack::IntegralStack(const LayerStack& stack, std::span<const std::string> layers,
-                             std::optional<double> referenceHue, bool squared)
+                             std::optional<double> referenceHue, bool squaredAll,
+                             const std::vector<bool>& contrastNormalised)
     : width_(stack.width()), height_(stack.height()) {
   if (width_ <= 0 || height_ <= 0)
     throw std::invalid_argument("IntegralStack: stack has no reference size");
+  if (!contrastNormalised.empty() && contrastNormalised.size() != layers.size())
+    throw std::invalid_argument("IntegralStack: " + std::to_string(contrastNormalised.size()) +
+                                " contrast normalisation flags for " + std::to_string(layers.size()) + " layers");
   layers_.reserve(layers.size());
-  for (const std::string& name : layers) {
+  for (std::size_t i = 0; i < layers.size(); ++i) {
+    const std::string& name = layers[i];
+    const bool normalised = i < contrastNormalised.size() && contrastNormalised[i];
+    const bool squared = squaredAll || normalised;
     const Layer* l = stack.find(name);
     if (!l && name == layer::kHueDistance && stack.has(layer::kHue)) {
       if (!referenceHue)
@@ -74,11 +81,18 @@ IntegralStack::IntegralStack(const LayerStack& stack, std::span<const std::strin
       cv::Mat hue = hueLayer.data;
       if (hue.type() != CV_32FC1) hue.convertTo(hue, CV_32F);
       layers_.push_back(integrateLayer(name, hueDistanceLayer(hue, hueLayer.valid, *referenceHue), squared));
-      continue;
+    } else {
+      if (!l) stack.at(name);  // throws, naming the missing layer and the ones present
+      layers_.push_back(integrateLayer(name, l->data, squared));
     }
-    if (!l) stack.at(name);  // throws, naming the missing layer and the ones present
-    layers_.push_back(integrateLayer(name, l->data, squared));
+    layers_.back().contrastNormalised = normalised;
   }
+}
+
+std::vector<bool> IntegralStack::contrastNormalised() const {
+  std::vector<bool> out;
+  for (const LayerIntegral& l : layers_) out.push_back(l.contrastNormalised);
+  return out;
 }
 
 }  // namespace fusedet::boosting

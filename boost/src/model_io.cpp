@@ -2,6 +2,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -90,12 +91,18 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   }
   std::ostringstream o;
   o << "{\n";
+  std::vector<std::string> normalised;
+  for (std::size_t l = 0; l < c.layers.size(); ++l)
+    if (c.isContrastNormalised(l)) normalised.push_back(c.layers[l]);
   o << "  \"format\": " << Json(kModelFormatName).dump() << ",\n";
-  o << "  \"version\": " << kModelFormatVersion << ",\n";
+  // Version 1 unless a layer is contrast-normalised: such a model must not load in a build that
+  // would ignore the field and decide differently; every other model keeps its bytes.
+  o << "  \"version\": " << (normalised.empty() ? 1 : kModelFormatVersion) << ",\n";
   o << "  \"class\": " << Json(c.className).dump() << ",\n";
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
+  if (!normalised.empty()) o << "  \"contrast_normalised\": " << Json(normalised).dump() << ",\n";
   if (!info.empty()) {
     Json t = Json::object();
     for (const auto& [k, v] : info) t[k] = v;
@@ -138,8 +145,8 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   const std::string format = r.string(root, "", "format");
   if (format != kModelFormatName) r.fail("format", "'" + format + "' is not a fusedet cascade model");
   const int version = r.integer(root, "", "version", 1, 1 << 20);
-  if (version != kModelFormatVersion)
-    r.fail("version", "unsupported version " + std::to_string(version) + " (this build reads " +
+  if (version < 1 || version > kModelFormatVersion)
+    r.fail("version", "unsupported version " + std::to_string(version) + " (this build reads 1 to " +
                           std::to_string(kModelFormatVersion) + ")");
   Cascade c;
   c.source = source;
@@ -158,6 +165,22 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   }
   const Json& hue = r.field(root, "", "reference_hue");
   if (!hue.is_null()) c.referenceHue = r.number(root, "", "reference_hue");
+  // Optional (absent in version 1 files: no layer is normalised, the decisions stay as before).
+  if (root.contains("contrast_normalised")) {
+    const Json& cn = r.array(root, "", "contrast_normalised");
+    c.contrastNormalised.assign(c.layers.size(), false);
+    for (std::size_t i = 0; i < cn.size(); ++i) {
+      const std::string at = Reader::at("contrast_normalised", i);
+      if (!cn[i].is_string()) r.fail(at, "expected a layer name (string), got " + Reader::typeName(cn[i]));
+      const std::string name = cn[i].get<std::string>();
+      const auto li = std::find(c.layers.begin(), c.layers.end(), name);
+      if (li == c.layers.end()) r.fail(at, "layer '" + name + "' is not in \"layers\"");
+      const auto l = static_cast<std::size_t>(li - c.layers.begin());
+      if (c.contrastNormalised[l]) r.fail(at, "layer '" + name + "' listed twice");
+      c.contrastNormalised[l] = true;
+    }
+    if (cn.empty()) c.contrastNormalised.clear();
+  }
   const Json& stages = r.array(root, "", "stages");
   if (stages.empty()) r.fail("stages", "no stages");
   std::vector<std::pair<Feature, int>> seen;  // features in first-use order (shared by stumps)

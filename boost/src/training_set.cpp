@@ -79,14 +79,16 @@ DatasetItem flipItem(const DatasetItem& item) {
 
 TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                const std::vector<std::string>& layers,
-                               std::optional<double> referenceHue, const SampleConfig& config, Shard shard)
+                               std::optional<double> referenceHue, const SampleConfig& config, Shard shard,
+                               const std::vector<bool>& contrastNormalised)
     : config_(config), shard_(shard) {
   std::mt19937_64 rng(config_.jitterSeed);
   auto addStack = [&](const DatasetItem& item, std::size_t itemIndex) {
     const auto index = static_cast<std::uint32_t>(integrals_.size());
     const bool mine = shard_.owns(itemIndex);
     try {
-      integrals_.push_back(mine ? IntegralStack(item.stack, layers, referenceHue) : IntegralStack());
+      integrals_.push_back(mine ? IntegralStack(item.stack, layers, referenceHue, false, contrastNormalised)
+                                : IntegralStack());
     } catch (const std::exception& e) {
       throw std::runtime_error("training item " + item.id + ": " + e.what());
     }

@@ -233,3 +233,92 @@ TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
   sf.feature(first + 5, one);
   for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(one[i], out[5 * n + i]);
 }
+
+// Contrast-normalised layers: the sample path equals featureValue() on them too (the trainer's
+// values are those detection computes).
+TEST(SampleFeatures, EqualsFeatureValueBitForBitOnContrastNormalisedLayers) {
+  std::vector<DatasetItem> items;
+  for (unsigned s = 0; s < 3; ++s) {
+    DatasetItem it = scene(310 + s, 2, false);
+    cv::Mat half, f;
+    cv::resize(it.stack.at("intensity").data, half, cv::Size(100, 60));
+    half.convertTo(f, CV_32F, 0.37, -3.1);
+    it.stack.set(Layer{"distance", f, {}});
+    items.push_back(it);
+  }
+  SampleConfig sc;
+  sc.minPositiveHeight = 20;
+  for (const std::vector<bool>& flags : {std::vector<bool>{true, false}, std::vector<bool>{true, true}}) {
+    const TrainingStacks stacks(items, {"intensity", "distance"}, std::nullopt, sc, Shard{}, flags);
+    ASSERT_TRUE(stacks.integrals(0).layer(0).contrastNormalised);
+    PoolConfig pc;
+    pc.grid = 6;
+    pc.layers = {"intensity", "distance"};
+    const auto pool = generatePool(pc);
+    std::vector<Sample> samples = stacks.positives();
+    std::mt19937 rng(4);
+    for (int k = 0; k < 40; ++k) {
+      const double w = 20 + double(rng() % 4) * 7.3, h = w * 0.6;
+      samples.push_back(Sample{std::uint32_t(rng() % stacks.size()), Box{double(rng() % 150), double(rng() % 80), w, h}});
+    }
+    const SampleFeatures sf(stacks, pool, samples);
+    const std::size_t n = samples.size();
+    std::vector<float> out(pool.size() * n);
+    sf.block(0, pool.size(), out);
+    std::size_t mismatches = 0, differs = 0;
+    for (std::size_t k = 0; k < pool.size(); ++k)
+      for (std::size_t i = 0; i < n; ++i) {
+        const float ref = featureValue(stacks.integrals(samples[i].stack), pool[k], samples[i].window);
+        mismatches += std::memcmp(&ref, &out[k * n + i], sizeof ref) != 0;
+      }
+    // Normalised values are not the raw ones (the division happened).
+    const TrainingStacks raw(items, {"intensity", "distance"}, std::nullopt, sc);
+    for (std::size_t i = 0; i < n; ++i)
+      differs += featureValue(raw.integrals(samples[i].stack), pool[0], samples[i].window) != out[i];
+    EXPECT_EQ(mismatches, 0u) << "of " << pool.size() * n;
+    EXPECT_GT(differs, n / 2);
+  }
+}
+
+// Training with contrast normalisation records it in the model (file round trip) and yields a
+// cascade that finds the cars in unseen scenes taken with half the contrast and another offset.
+TEST(CascadeTrainer, ContrastNormalisedTrainingIsRecordedAndSurvivesAGainChange) {
+  const auto items = scenes(12, false);
+  TrainingConfig config = smallConfig();
+  config.pool.contrastNormalised = {"intensity"};
+  NullProgress quiet;
+  TrainingReport report;
+  const Cascade c = trainCascade(config, items, quiet, &report);
+  ASSERT_EQ(c.contrastNormalised, std::vector<bool>{true});
+  const Cascade back = modelFromText(modelToText(c), "n.json");
+  EXPECT_EQ(back.contrastNormalised, c.contrastNormalised);
+  const Detector det(back);
+  ScanParams p;
+  p.scaleFactor = 1.1;
+  p.step = 1;
+  std::size_t found = 0, cars = 0, hits = 0, windows = 0;
+  for (unsigned s = 900; s < 906; ++s) {
+    DatasetItem t = scene(s, 2, false);
+    cv::Mat dim;
+    t.stack.at("intensity").data.convertTo(dim, CV_8U, 0.5, 40);
+    t.stack.set(Layer{"intensity", dim, {}});
+    ScanStats stats;
+    const auto raw = det.scan(t.stack, p, &stats);
+    windows += stats.windows;
+    hits += raw.size();
+    for (const Label& l : t.labels) {
+      if (l.className != "car") continue;
+      ++cars;
+      for (const RawHit& h : raw)
+        if (iou(h.box, l.box) >= 0.5) {
+          ++found;
+          break;
+        }
+    }
+  }
+  EXPECT_GE(double(found), 0.8 * double(cars)) << found << " of " << cars << "; " << report.stopReason;
+  EXPECT_LT(double(hits) / double(windows), 0.05);
+  // A layer that is not in the pool is refused.
+  config.pool.contrastNormalised = {"distance"};
+  EXPECT_THROW(trainCascade(config, items, quiet), std::invalid_argument);
+}

@@ -133,3 +133,82 @@ TEST(ModelIo, FuzzedFilesNeverCrash) {
   EXPECT_GT(rejected, 0);
   EXPECT_EQ(loaded + rejected, 3000);
 }
+
+// Contrast-normalised layers are recorded per layer (format version 2); models without any stay
+// version 1 byte for byte, and files without the field load as "not normalised".
+TEST(ModelIo, ContrastNormalisedLayersRoundTrip) {
+  Cascade c = sample();
+  c.contrastNormalised = {true, false};
+  const std::string text = modelToText(c);
+  EXPECT_NE(text.find("\"version\": 2"), std::string::npos);
+  EXPECT_NE(text.find("\"contrast_normalised\": [\"intensity\"]"), std::string::npos) << text;
+  const Cascade back = modelFromText(text, "m.json");
+  EXPECT_EQ(back.contrastNormalised, c.contrastNormalised);
+  EXPECT_TRUE(back.isContrastNormalised(0));
+  EXPECT_FALSE(back.isContrastNormalised(1));
+  EXPECT_EQ(modelToText(back), text);
+
+  const std::string old = modelToText(sample());
+  EXPECT_EQ(old.find("contrast_normalised"), std::string::npos);
+  EXPECT_NE(old.find("\"version\": 1"), std::string::npos);
+  const Cascade plain = modelFromText(old, "old.json");
+  EXPECT_TRUE(plain.contrastNormalised.empty());
+  EXPECT_FALSE(plain.isContrastNormalised(0));
+  // An empty list is "none" too.
+  EXPECT_TRUE(modelFromText(replace(text, "[\"intensity\"]", "[]"), "m.json").contrastNormalised.empty());
+}
+
+TEST(ModelIo, BadContrastNormalisedFieldIsAClearError) {
+  Cascade c = sample();
+  c.contrastNormalised = {true, false};
+  const std::string good = modelToText(c);
+  const std::string field = "\"contrast_normalised\": [\"intensity\"]";
+  auto with = [&](const std::string& value) { return errorOf(replace(good, field, "\"contrast_normalised\": " + value)); };
+  EXPECT_NE(with("[\"sonar\"]").find("m.json: contrast_normalised[0]: layer 'sonar' is not in \"layers\""),
+            std::string::npos)
+      << with("[\"sonar\"]");
+  EXPECT_NE(with("\"intensity\"").find("m.json: contrast_normalised: expected an array, got string"),
+            std::string::npos);
+  EXPECT_NE(with("true").find("contrast_normalised: expected an array, got boolean"), std::string::npos);
+  EXPECT_NE(with("[1]").find("contrast_normalised[0]: expected a layer name (string), got number"),
+            std::string::npos);
+  EXPECT_NE(with("[\"intensity\", \"hue_distance\", \"intensity\"]")
+                .find("contrast_normalised[2]: layer 'intensity' listed twice"),
+            std::string::npos);
+  EXPECT_NE(with("{\"intensity\": true}").find("expected an array, got object"), std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 3")).find("unsupported version 3 (this build reads 1 to 2)"),
+            std::string::npos);
+  // Invalid in memory: flags of the wrong size.
+  c.contrastNormalised = {true};
+  EXPECT_THROW(modelToText(c), ModelError);
+}
+
+TEST(ModelIo, FuzzedContrastNormalisedFieldNeverCrashes) {
+  Cascade c = sample();
+  c.contrastNormalised = {true, true};
+  const std::string good = modelToText(c);
+  const std::size_t at = good.find("\"contrast_normalised\"");
+  ASSERT_NE(at, std::string::npos);
+  const std::size_t end = good.find('\n', at);
+  std::mt19937 rng(12);
+  int loaded = 0, rejected = 0;
+  for (int it = 0; it < 2000; ++it) {
+    std::string s = good;
+    const std::size_t p = at + rng() % (end - at);
+    switch (rng() % 3) {
+      case 0: s[p] = "{}[],:\"0-e9.tnu "[rng() % 16]; break;
+      case 1: s.erase(p, 1 + rng() % 6); break;
+      default: s.insert(p, 1, "{}[],:\"0-e9.tnu "[rng() % 16]); break;
+    }
+    try {
+      const Cascade back = modelFromText(s, "fuzz.json");
+      EXPECT_TRUE(back.contrastNormalised.empty() || back.contrastNormalised.size() == back.layers.size());
+      ++loaded;
+    } catch (const ModelError& e) {
+      EXPECT_NE(std::string(e.what()).find("fuzz.json"), std::string::npos) << e.what();
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+  EXPECT_EQ(loaded + rejected, 2000);
+}

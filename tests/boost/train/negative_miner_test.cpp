@@ -159,3 +159,22 @@ TEST(NegativeMiner, LabelTestEqualsTheLabelByLabelRule) {
     EXPECT_LT(negatives, windows.size());
   }
 }
+
+// With a contrast-normalised layer the miner (per-window contrasts from the squared sums) still
+// trains the rescan's model, byte for byte.
+TEST(NegativeMiner, TrainsTheSameContrastNormalisedModelAsTheFullRescan) {
+  TrainingConfig rescan = smallCarConfig();
+  rescan.pool.contrastNormalised = {"intensity"};
+  rescan.maxStages = 4;
+  rescan.incrementalMining = false;
+  TrainingConfig incremental = rescan;
+  incremental.incrementalMining = true;
+  NullProgress quiet;
+  TrainingReport a, b;
+  const Cascade old = trainCascade(rescan, kittiItems(), quiet, &a);
+  const Cascade fast = trainCascade(incremental, kittiItems(), quiet, &b);
+  ASSERT_GE(old.stages.size(), 3u) << a.stopReason;
+  ASSERT_EQ(old.contrastNormalised, (std::vector<bool>{true, false, false}));
+  EXPECT_EQ(modelToText(fast), modelToText(old));
+  EXPECT_EQ(b.stopReason, a.stopReason);
+}

@@ -1,6 +1,6 @@
 #pragma once
 // Model files of our cascades: versioned, human-readable JSON (one stump per line), holding the
-// class, window size (aspect ratio), layer names, reference hue and the stages with their
+// class, window size (aspect ratio), layer names, reference hue, contrast-normalised layers and the stages with their
 // thresholds and stumps (feature type letter, unit-square rectangle, layer name, threshold, two
 // leaf values). Writing is deterministic: the same cascade gives the same bytes.
 //
@@ -11,6 +11,7 @@
 //     "window": {"width":40,"height":24},
 //     "layers": ["intensity","distance"],
 //     "reference_hue": 25,
+//     "contrast_normalised": ["intensity"],   (version 2 only; optional; absent = none)
 //     "training": {"seed":"1", ...},          (optional, informative, ignored when loading)
 //     "stages": [
 //       {"threshold":-0.41,"stumps":[
@@ -31,7 +32,10 @@
 
 namespace fusedet::boosting {
 
-inline constexpr int kModelFormatVersion = 1;
+// Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
+// standard deviation, feature.h); models without it are still written as version 1, byte for
+// byte as before. Both versions load.
+inline constexpr int kModelFormatVersion = 2;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.
