@@ -11,17 +11,38 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/service_parts.h"
 #include "fusedet/daemon/stats.h"
+#include "fusedet/daemon/thread_info.h"
 #include "fusedet/fusion/synth_log.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
 namespace fs = std::filesystem;
+
+namespace {
+
+std::string loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  std::string a, b, c;
+  in >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+// CPU time each thread used since `before` (threads that started later: all of theirs).
+std::vector<ThreadCpu> since(const std::vector<ThreadCpu>& before, std::vector<ThreadCpu> now) {
+  for (ThreadCpu& t : now)
+    for (const ThreadCpu& b : before)
+      if (b.tid == t.tid) t.cpuMs -= b.cpuMs;
+  return now;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"bench_daemon_latency - sensor stamp to socket client latency of fusedetd replaying a sensor log"};
@@ -36,6 +57,7 @@ int main(int argc, char** argv) {
   app.add_option("--speed", speed, "replay speed (1 = as recorded)")->capture_default_str();
   app.add_option("--threads", threads, "detection threads (0 = all cores)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
+  const std::string loadAtStart = loadAverage();
 
   const fs::path tmp = fs::temp_directory_path() / ("fusedet-bench-" + std::to_string(::getpid()));
   fs::create_directories(tmp);
@@ -64,9 +86,12 @@ int main(int argc, char** argv) {
   Service service(std::move(parts));
   Client client(config.socket.path);
   client.send({{"cmd", "subscribe"}});
+  const std::vector<ThreadCpu> threadsAtStart = processThreadCpu();
   service.start();
 
-  std::vector<double> latency, compute;
+  std::vector<double> latency, compute, deliver;
+  std::map<std::string, std::vector<double>> stages;  // stages_ms of each detections line
+  std::vector<std::string> perStack;
   std::uint64_t lastStack = UINT64_MAX;  // the last stack of the last pass, once fusion has flushed it
   while (true) {
     auto line = client.readLine(std::chrono::seconds(30));
@@ -76,20 +101,30 @@ int main(int argc, char** argv) {
     if (m["type"] != "detections") continue;
     latency.push_back(static_cast<double>(received.ns - m["sensor_ns"].get<std::int64_t>()) * 1e-6);
     compute.push_back(m["fuse_ms"].get<double>() + m["detect_ms"].get<double>());
+    for (const auto& [stage, ms] : m["stages_ms"].items()) stages[stage].push_back(ms.get<double>());
+    deliver.push_back(static_cast<double>(received.ns - m["detected_ns"].get<std::int64_t>()) * 1e-6);
+    char row[200];
+    std::snprintf(row, sizeof row, "  %5llu %9.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %4zu",
+                  static_cast<unsigned long long>(m["stack"].get<std::uint64_t>()), latency.back(),
+                  stages["close"].back(), stages["decode"].back() + stages["fuse"].back(), stages["fuse_cpu"].back(),
+                  stages["queue"].back(), stages["detect"].back(), stages["detect_cpu"].back(), deliver.back(),
+                  m["detections"].size());
+    perStack.push_back(row);
     const auto pc = service.pipeline().counters();
     if (lastStack == UINT64_MAX && pc.streamEnds >= static_cast<std::uint64_t>(passes)) lastStack = pc.stacksFused - 1;
     if (m["stack"].get<std::uint64_t>() >= lastStack) break;
   }
   const auto c = service.pipeline().counters();
   const auto status = service.status();
+  const std::vector<ThreadCpu> threadCpu = since(threadsAtStart, processThreadCpu());
   service.stop(std::chrono::steady_clock::now() + std::chrono::milliseconds(1500));
   fs::remove_all(tmp);
 
-  double load = 0;
-  std::ifstream("/proc/loadavg") >> load;
   std::printf("daemon latency, replay: %s; %d passes at %.2fx recorded speed, re-stamped; classes car bike person, "
-              "detection threads %d (0 = all), %u cores, load average %.2f\n",
-              scene.c_str(), passes, speed, threads, std::thread::hardware_concurrency(), load);
+              "detection threads %d (0 = all), %u cores\n",
+              scene.c_str(), passes, speed, threads, std::thread::hardware_concurrency());
+  std::printf("load average (/proc/loadavg 1/5/15 min) at start: %s, at end: %s\n", loadAtStart.c_str(),
+              loadAverage().c_str());
   std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind), %llu unpaired sweeps\n",
               latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),
               static_cast<unsigned long long>(c.unpaired));
@@ -101,8 +136,32 @@ int main(int argc, char** argv) {
               percentile(latency, 0.5), percentile(latency, 0.9), percentile(latency, 0.99), percentile(latency, 1.0));
   std::printf("%-44s p50 %8.1f  p90 %8.1f  p99 %8.1f  max %8.1f ms\n", "fuse + detect only, same stacks (floor)",
               percentile(compute, 0.5), percentile(compute, 0.9), percentile(compute, 0.99), percentile(compute, 1.0));
+  auto row = [](const char* what, const std::vector<double>& v) {
+    std::printf("  %-42s p50 %8.1f  p90 %8.1f  p99 %8.1f  max %8.1f ms\n", what, percentile(v, 0.5),
+                percentile(v, 0.9), percentile(v, 0.99), percentile(v, 1.0));
+  };
+  std::printf("per stage (wall unless cpu = the thread's own CPU time):\n");
+  row("sensor stamp -> fusion starts (close)", stages["close"]);
+  row("camera frame decode", stages["decode"]);
+  row("fuse", stages["fuse"]);
+  row("decode + fuse, fusion thread cpu", stages["fuse_cpu"]);
+  row("stack queue", stages["queue"]);
+  row("detect (3 classes)", stages["detect"]);
+  row("detect, detection thread cpu", stages["detect_cpu"]);
+  row("localize", stages["localize"]);
+  row("detection done -> client receives", deliver);
+  std::printf("per stack, ms: stack latency close decode+fuse fuse_cpu queue detect detect_cpu deliver detections\n");
+  for (const std::string& r : perStack) std::printf("%s\n", r.c_str());
+  std::printf("CPU time per thread during the replay, ms (fd-* = the daemon's threads; unnamed: TBB workers, the bench's client):\n");
+  for (const ThreadCpu& t : threadCpu)
+    if (t.cpuMs > 0) std::printf("  %-16s %9.1f\n", t.name.c_str(), t.cpuMs);
+  std::printf("bench: compute_p50_ms %.1f\n", percentile(compute, 0.5));
+  std::printf("bench: compute_p99_ms %.1f\n", percentile(compute, 0.99));
+  std::printf("bench: close_p50_ms %.1f\n", percentile(stages["close"], 0.5));
+  std::printf("bench: fuse_cpu_p50_ms %.1f\n", percentile(stages["fuse_cpu"], 0.5));
+  std::printf("bench: detect_p50_ms %.1f\n", percentile(stages["detect"], 0.5));
+  std::printf("bench: detect_cpu_p50_ms %.1f\n", percentile(stages["detect_cpu"], 0.5));
   std::printf("bench: latency_p50_ms %.1f\n", percentile(latency, 0.5));
   std::printf("bench: latency_p99_ms %.1f\n", percentile(latency, 0.99));
-  std::printf("bench: compute_p50_ms %.1f\n", percentile(compute, 0.5));
   return 0;
 }

@@ -89,6 +89,7 @@ bool Pipeline::idle() const {
 }
 
 void Pipeline::fusionLoop() {
+  nameThisThread("fd-fusion");
   while (!abandon_) {
     fusionBeat_ = Stamp::now().ns;
     auto message = sensorQueue_.pop(kIdleWake);
@@ -136,6 +137,9 @@ void Pipeline::handle(SensorMessage& message) {
 
 void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFrame& frame) {
   const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = threadCpuMs();
+  FusedStack fused;
+  fused.stages.closeMs = static_cast<double>(Stamp::now().ns - std::max(sweep.end, frame.stamp).ns) * 1e-6;
   Result<cv::Mat> bgr = fusion::decodeCameraFrame(frame);
   if (!bgr) {
     std::lock_guard lock(countersMutex_);
@@ -143,7 +147,7 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
     spdlog::warn("camera frame {}: {}", frame.sequence, bgr.error().message());
     return;
   }
-  FusedStack fused;
+  const auto t1 = std::chrono::steady_clock::now();
   fused.stack = setup_.fuser->fuse(bgr.value(), sweep);
   fused.stack.id = nextStackId_++;
   fused.stack.stamp = frame.stamp;
@@ -151,7 +155,11 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
   fused.sweepStart = sweep.start;
   fused.sweepEnd = sweep.end;
   fused.frameStamp = frame.stamp;
-  fused.fuseMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const auto t2 = std::chrono::steady_clock::now();
+  fused.fuseMs = std::chrono::duration<double, std::milli>(t2 - t0).count();
+  fused.stages.decodeMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
+  fused.stages.fuseMs = std::chrono::duration<double, std::milli>(t2 - t1).count();
+  fused.stages.fuseCpuMs = threadCpuMs() - cpu0;
   {
     std::lock_guard lock(countersMutex_);
     ++counters_.stacksFused;
@@ -162,10 +170,12 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
       if (abandon_ || stackQueue_.closed()) return;
       fusionBeat_ = Stamp::now().ns;  // waiting for detection is not a stall of this thread
     }
+  fused.queuedAt = std::chrono::steady_clock::now();
   stackQueue_.push(std::move(fused));
 }
 
 void Pipeline::detectionLoop() {
+  nameThisThread("fd-detect");
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
   const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;
   while (!abandon_) {
@@ -183,9 +193,16 @@ void Pipeline::detectionLoop() {
     result->frameStamp = fused->frameStamp;
     result->sensorStamp = std::max(fused->sweepEnd, fused->frameStamp);
     result->fuseMs = fused->fuseMs;
+    result->stages = fused->stages;
     const auto t0 = std::chrono::steady_clock::now();
+    result->stages.queueMs = std::chrono::duration<double, std::milli>(t0 - fused->queuedAt).count();
     try {
-      for (Detection& d : detector->detect(fused->stack)) {
+      const double cpu0 = threadCpuMs();
+      std::vector<Detection> found = detector->detect(fused->stack);
+      result->stages.detectCpuMs = threadCpuMs() - cpu0;
+      const auto t1 = std::chrono::steady_clock::now();
+      result->stages.detectMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
+      for (Detection& d : found) {
         LocatedDetection located;
         located.position = localize(fused->stack, d.box, K, sweepToCamera);
         if (located.position) d.position = std::array<double, 3>{located.position->robot.x(), located.position->robot.y(), located.position->robot.z()};
@@ -198,7 +215,9 @@ void Pipeline::detectionLoop() {
       spdlog::warn("detection on stack {}: {}", result->stackId, e.what());
       continue;
     }
-    result->detectMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    const auto t2 = std::chrono::steady_clock::now();
+    result->detectMs = std::chrono::duration<double, std::milli>(t2 - t0).count();
+    result->stages.localizeMs = result->detectMs - result->stages.detectMs;
     result->detectedAt = Stamp::now();
     stackRate_.tick(result->detectedAt.ns);
     const std::size_t found = result->detections.size();

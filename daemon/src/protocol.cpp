@@ -85,6 +85,14 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
           {"detected_ns", r.detectedAt.ns},
           {"fuse_ms", r.fuseMs},
           {"detect_ms", r.detectMs},
+          {"stages_ms", {{"close", r.stages.closeMs},
+                         {"decode", r.stages.decodeMs},
+                         {"fuse", r.stages.fuseMs},
+                         {"fuse_cpu", r.stages.fuseCpuMs},
+                         {"queue", r.stages.queueMs},
+                         {"detect", r.stages.detectMs},
+                         {"detect_cpu", r.stages.detectCpuMs},
+                         {"localize", r.stages.localizeMs}}},
           {"detections", std::move(dets)}};
 }
 

@@ -1,6 +1,7 @@
 #include "fusedet/daemon/scene_source.h"
 
 #include "fusedet/core/stamp.h"
+#include "fusedet/daemon/thread_info.h"
 
 namespace fusedet::daemon {
 
@@ -23,6 +24,7 @@ void SceneSource::stop() {
 }
 
 void SceneSource::run(SensorSink& sink) {
+  nameThisThread("fd-scenes");
   auto next = std::chrono::steady_clock::now();
   for (std::size_t round = 0; rounds_ == 0 || round < rounds_; ++round) {
     for (const PairedScene& original : scenes_) {

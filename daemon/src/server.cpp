@@ -17,6 +17,7 @@
 #include <system_error>
 
 #include "fusedet/daemon/protocol.h"
+#include "fusedet/daemon/thread_info.h"
 
 namespace fusedet::daemon {
 namespace {
@@ -129,6 +130,7 @@ ServerCounters Server::counters() const {
 }
 
 void Server::run() {
+  nameThisThread("fd-server");
   epoll_event events[64];
   auto findClient = [this](std::uint64_t key) -> Client* {
     for (auto& c : clients_)

@@ -4,6 +4,7 @@
 
 #include "fusedet/drivers/canopen/can_node.h"
 #include "fusedet/drivers/canopen/socketcan_bus.h"
+#include "fusedet/daemon/thread_info.h"
 
 namespace fusedet::daemon {
 
@@ -35,6 +36,7 @@ void TiltSource::stop() {
 }
 
 void TiltSource::run(SensorSink& sink) {
+  nameThisThread("fd-tilt");
   auto setState = [this](const std::string& s, const std::string& error = {}) {
     std::lock_guard lock(mutex_);
     state_ = s;

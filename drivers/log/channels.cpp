@@ -3,6 +3,9 @@
 #include <cmath>
 #include <cstring>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string_view>
+#include <utility>
 
 #include "fusedet/drivers/log/base64.h"
 
@@ -72,10 +75,71 @@ std::vector<std::uint8_t> bytesOf(const json& j) {
 
 Error bad(const std::string& what) { return makeError(std::errc::bad_message, what); }
 
+// Where the string value of the top-level member "data" lies in a message: [begin, end) between
+// its quotes. Empty if there is none, or more than one, or the text is not plain JSON around it.
+std::optional<std::pair<std::size_t, std::size_t>> findTopLevelData(std::span<const std::uint8_t> b) {
+  std::optional<std::pair<std::size_t, std::size_t>> found;
+  const auto skipSpace = [&](std::size_t i) {
+    while (i < b.size() && (b[i] == ' ' || b[i] == '\t' || b[i] == '\n' || b[i] == '\r')) ++i;
+    return i;
+  };
+  int depth = 0;
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    const std::uint8_t c = b[i];
+    if (c == '{' || c == '[') {
+      ++depth;
+    } else if (c == '}' || c == ']') {
+      --depth;
+    } else if (c == '"') {
+      const std::size_t start = i + 1;
+      for (++i; i < b.size() && b[i] != '"'; ++i)
+        if (b[i] == '\\') ++i;  // an escaped character, maybe a quote
+      if (i >= b.size()) return std::nullopt;
+      if (depth != 1 || i - start != 4 || std::memcmp(&b[start], "data", 4) != 0) continue;
+      std::size_t v = skipSpace(i + 1);
+      if (v >= b.size() || b[v] != ':') continue;  // "data" as a value, not a key
+      v = skipSpace(v + 1);
+      if (v >= b.size() || b[v] != '"' || found) return std::nullopt;  // not a string, or a second "data"
+      const auto* quote = static_cast<const std::uint8_t*>(std::memchr(b.data() + v + 1, '"', b.size() - v - 1));
+      if (!quote) return std::nullopt;
+      const std::size_t end = static_cast<std::size_t>(quote - b.data());
+      if (std::memchr(b.data() + v + 1, '\\', end - v - 1)) return std::nullopt;  // escapes: not plain base64
+      found = std::make_pair(v + 1, end);
+      i = end;
+    }
+  }
+  return found;
+}
+
+// A message with a large base64 payload (a camera frame: ~1.2 MB in "data") parsed without
+// running that payload through the JSON lexer, which copies it a character at a time - most of
+// a replay's CPU time before. The rest of the message is parsed as usual and the payload,
+// decoded straight from the message bytes, becomes a binary value (dataOf reads both kinds).
+// Anything unusual returns nothing and is left to the ordinary parse, which gives the same
+// result or the same error.
+std::optional<json> parseLiftingData(std::span<const std::uint8_t> bytes) {
+  constexpr std::size_t kWorthIt = 4096;  // small messages: the ordinary parse is as fast
+  if (bytes.size() < kWorthIt) return std::nullopt;
+  const auto data = findTopLevelData(bytes);
+  if (!data || data->second - data->first < kWorthIt / 2) return std::nullopt;
+  auto payload = base64Decode(std::string_view(reinterpret_cast<const char*>(bytes.data()) + data->first,
+                                               data->second - data->first));
+  if (!payload) return std::nullopt;
+  std::vector<std::uint8_t> rest(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(data->first));
+  rest.insert(rest.end(), bytes.begin() + static_cast<std::ptrdiff_t>(data->second), bytes.end());
+  json j = json::parse(rest.begin(), rest.end(), nullptr, false);
+  // The member left behind must be the emptied "data" (a later duplicate key would win in the
+  // ordinary parse: leave such a message to it).
+  if (j.is_discarded() || !j.is_object() || j.value("data", json()) != "") return std::nullopt;
+  j["data"] = json::binary(std::move(*payload));
+  return j;
+}
+
 // Parses a message; every accessor below throws json exceptions that decode() turns into errors.
 template <class T, class F>
 Result<T> decode(std::span<const std::uint8_t> bytes, const char* what, F&& f) {
-  const json j = json::parse(bytes.begin(), bytes.end(), nullptr, false);
+  std::optional<json> lifted = parseLiftingData(bytes);
+  const json j = lifted ? std::move(*lifted) : json::parse(bytes.begin(), bytes.end(), nullptr, false);
   if (j.is_discarded() || !j.is_object()) return bad(std::string(what) + ": not a JSON object");
   try {
     return f(j);
@@ -92,6 +156,7 @@ Stamp stampOf(const json& j) {
 }
 
 std::vector<std::uint8_t> dataOf(const json& j) {
+  if (const json& v = j.at("data"); v.is_binary()) return {v.get_binary().begin(), v.get_binary().end()};
   auto d = base64Decode(j.at("data").get<std::string>());
   if (!d) throw std::invalid_argument("field 'data' is not base64");
   return std::move(*d);

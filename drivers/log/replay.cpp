@@ -21,6 +21,14 @@ std::optional<LogRig> LogSource::rig() const {
   return rig;
 }
 
+void LogSource::rewind(std::int64_t restampFromNs) {
+  options_.restampFromNs = restampFromNs;
+  cursor_ = reader_.messages();
+  counters_ = {};
+  firstLogTime_.reset();
+  shiftNs_ = 0;
+}
+
 bool LogSource::waitUntilDue(std::uint64_t logTime, const std::atomic<bool>* stop) {
   if (!firstLogTime_) {
     firstLogTime_ = logTime;
@@ -82,9 +90,24 @@ bool LogSource::step(const Handlers& h, const std::atomic<bool>* stop) {
 
 SensorReplay::SensorReplay(const std::filesystem::path& log, SensorReplayConfig config, ReplayOptions options)
     : source_(log, options), config_(std::move(config)), tilt_(config_.tilt.node, config_.tilt.units) {
+  resetScanDecoder();
+}
+
+void SensorReplay::resetScanDecoder() {
   const lms291::Lms291Config& l = config_.laser;
   // What Lms291::start() sets the device to: the unit, and measuring mode 0x0D for range+remission.
   scans_.reset(l.variant, l.remission, l.remission ? lms291::kMeasuringRemission : l.measuringMode, l.unit);
+}
+
+void SensorReplay::rewind(std::int64_t restampFromNs) {
+  source_.rewind(restampFromNs);
+  telegrams_ = lms291::TelegramReader{lms291::Direction::kFromDevice};
+  scans_ = lms291::ScanDecoder{};
+  resetScanDecoder();
+  tilt_ = canopen::TiltTpdoDecoder(config_.tilt.node, config_.tilt.units);
+  baud_ = 0;
+  lastSerial_ = Stamp{};
+  frames_ = 0;
 }
 
 void SensorReplay::drainTelegrams(const Handlers& h, int baud) {

@@ -58,6 +58,7 @@ std::unique_ptr<Service> startReplay(const Config& config) {
 nlohmann::json content(nlohmann::json line) {
   line.erase("fuse_ms");
   line.erase("detect_ms");
+  line.erase("stages_ms");
   line.erase("detected_ns");
   return line;
 }
@@ -152,6 +153,7 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
 
   struct Got {
     std::vector<nlohmann::json> lines;
+    std::vector<nlohmann::json> stages;  // stages_ms of each line
     bool closed = false;
   };
   auto follow = [&](Got& got, std::chrono::milliseconds pause, const std::vector<std::string>& classes) {
@@ -171,6 +173,7 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
       }
       if ((*m)["type"] != "detections") continue;
       got.lines.push_back(content(*m));
+      got.stages.push_back((*m)["stages_ms"]);
       if ((*m)["stack"].get<std::uint64_t>() >= kLast) return;
       if (pause.count()) std::this_thread::sleep_for(pause);
     }
@@ -250,6 +253,16 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
   for (const auto& l : reference.lines) all[l["stack"].get<std::uint64_t>()] = l;
   const std::uint64_t firstSeen = reference.lines.front()["stack"];
   EXPECT_EQ(all.size(), kLast - firstSeen + 1);
+  // Each line says where its time went: every stage present, the measured durations not
+  // negative (`close` compares stamps with the clock: replayed faster than recorded, the stamps
+  // run ahead of it).
+  for (const auto& st : reference.stages) {
+    ASSERT_TRUE(st.contains("close") && st["close"].is_number()) << st.dump();
+    for (const char* key : {"decode", "fuse", "fuse_cpu", "queue", "detect", "detect_cpu", "localize"}) {
+      ASSERT_TRUE(st.contains(key)) << key << " missing in " << st.dump();
+      EXPECT_GE(st[key].get<double>(), 0.0) << key;
+    }
+  }
   // Every client that keeps up got every stack from its first on, identical to the reference.
   auto check = [&](const Got& g, bool bikesOnly) {
     ASSERT_FALSE(g.closed);

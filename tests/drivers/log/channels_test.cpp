@@ -110,6 +110,58 @@ TEST(Channels, CameraScanTiltRoundTrip) {
   EXPECT_EQ(dp->points, pc.points);
 }
 
+// Large payloads skip the JSON lexer (decode lifts the top-level "data" string out); whatever the
+// text around it looks like, the result must be what a JSON reader gives: written by hand here,
+// not by encode().
+TEST(Channels, LargeCameraPayloadsDecodeAsJsonSaysWhateverTheLayout) {
+  std::mt19937 rng(7);
+  auto frameBytes = [&] {
+    std::vector<std::uint8_t> b(64 * 40 * 2);
+    for (auto& x : b) x = static_cast<std::uint8_t>(rng());
+    return b;
+  };
+  const std::vector<std::uint8_t> a = frameBytes(), b = frameBytes();
+  const std::string a64 = base64Encode(a), b64 = base64Encode(b);
+  const std::string head = R"("timestamp":{"sec":3,"nsec":5},"width":64,"height":40,"encoding":"yuyv","step":128)";
+  auto decoded = [](const std::string& text) { return decodeCamera(span(text)); };
+
+  for (const std::string& text :
+       {"{\"data\":\"" + a64 + "\"," + head + "}",                       // first member, no spaces
+        "{ " + head + " ,\n \"data\" :\t \"" + a64 + "\" }",              // last, with white space
+        "{" + head + R"(,"frame_id":"data","extra":{"data":"xyz"},"data":")" + a64 + "\"}",  // "data" elsewhere
+        "{" + head + R"(,"x":"\"data\":\"AAAA","data":")" + a64 + "\"}"}) {         // inside an escaped string
+    auto r = decoded(text);
+    ASSERT_TRUE(r) << r.error().message();
+    EXPECT_EQ(r->bytes, a);
+    EXPECT_EQ(r->width, 64);
+    EXPECT_EQ(r->stamp.ns, 3'000'000'005);
+  }
+  // An escaped '/' is still JSON for '/': the same bytes.
+  std::string escaped = a64;
+  const std::size_t slash = escaped.find('/');
+  ASSERT_NE(slash, std::string::npos);
+  escaped.replace(slash, 1, "\\/");
+  auto r = decoded("{" + head + ",\"data\":\"" + escaped + "\"}");
+  ASSERT_TRUE(r) << r.error().message();
+  EXPECT_EQ(r->bytes, a);
+  // Duplicate keys: the last one wins, as in the JSON reader.
+  r = decoded("{\"data\":\"" + a64 + "\"," + head + ",\"data\":\"" + b64 + "\"}");
+  ASSERT_TRUE(r) << r.error().message();
+  EXPECT_EQ(r->bytes, b);
+  // Not base64, not a string, cut short anywhere: errors naming the message type, no crash.
+  std::string bad = a64;
+  bad[100] = '!';
+  const std::string whole = "{" + head + ",\"data\":\"" + a64 + "\"}";
+  std::vector<std::string> broken{"{" + head + ",\"data\":\"" + bad + "\"}", "{" + head + ",\"data\":[\"" + a64 + "\"]}",
+                                  "{" + head + ",\"data\":\"" + a64 + "\",}"};
+  for (std::size_t cut = 1; cut < whole.size(); cut += 97) broken.push_back(whole.substr(0, cut));
+  for (const std::string& text : broken) {
+    auto e = decoded(text);
+    ASSERT_FALSE(e) << text.substr(0, 80);
+    EXPECT_NE(e.error().message().find("camera image"), std::string::npos);
+  }
+}
+
 TEST(Channels, MalformedMessagesAreErrorsNamingTheProblem) {
   const std::string cases[] = {"", "[]", "{", R"({"timestamp":{"sec":1,"nsec":0}})",
                                R"({"timestamp":{"sec":1,"nsec":0},"device":"x","baud":1,"data":"!!"})",

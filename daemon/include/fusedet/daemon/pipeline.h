@@ -23,6 +23,7 @@
 #include "fusedet/daemon/source.h"
 #include "fusedet/daemon/stack_detector.h"
 #include "fusedet/daemon/stats.h"
+#include "fusedet/daemon/thread_info.h"
 #include "fusedet/fusion/fuser.h"
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
@@ -34,6 +35,20 @@ struct LocatedDetection {
   std::optional<Position> position;  // camera and robot frame, range, cells used
 };
 
+// Where one stack's time went, in milliseconds: wall time, and the thread's own CPU time where
+// it says Cpu (on a loaded machine wall time also counts waiting for a core).
+struct StageTimes {
+  double closeMs = 0;      // sensor stamp -> fusion starts on the pair: sweep closing (by the next
+                           // stroke's first scan), pairing, the sensor queue
+  double decodeMs = 0;     // camera frame -> BGR image
+  double fuseMs = 0;       // Fuser::fuse: undistortion, camera layers, projection, laser layers
+  double fuseCpuMs = 0;    // the fusion thread's CPU time for decode + fuse
+  double queueMs = 0;      // in the stack queue, waiting for the detection thread
+  double detectMs = 0;     // every class: integrals, window scan, grouping
+  double detectCpuMs = 0;  // the detection thread's CPU time for it (helper threads not counted)
+  double localizeMs = 0;   // 3D positions of the detections
+};
+
 // Everything the detection thread found in one stack.
 struct StackResult {
   std::uint64_t stackId = 0;
@@ -41,7 +56,8 @@ struct StackResult {
   Stamp frameStamp;            // the camera frame
   Stamp sensorStamp;           // the newest sensor stamp that went into the stack
   Stamp detectedAt;            // when detection finished
-  double fuseMs = 0, detectMs = 0;
+  double fuseMs = 0, detectMs = 0;  // detectMs: detection + localisation
+  StageTimes stages;
   std::vector<LocatedDetection> detections;
 };
 
@@ -119,6 +135,8 @@ class Pipeline : public SensorSink {
     LayerStack stack;
     Stamp sweepStart, sweepEnd, frameStamp;
     double fuseMs = 0;
+    StageTimes stages;
+    std::chrono::steady_clock::time_point queuedAt;
   };
 
   void fusionLoop();

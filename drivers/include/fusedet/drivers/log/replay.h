@@ -72,6 +72,10 @@ class LogSource {
   // False at the end of the log, or when *stop became true (checked while sleeping, too).
   bool step(const Handlers& handlers, const std::atomic<bool>* stop = nullptr);
   const ReplayCounters& counters() const { return counters_; }
+  // Back to the first message, as if just opened (counters, pacing and re-stamping start anew),
+  // without reading the file's index again: the next pass of a looping replay. restampFromNs
+  // replaces ReplayOptions::restampFromNs for that pass.
+  void rewind(std::int64_t restampFromNs = 0);
 
  private:
   bool waitUntilDue(std::uint64_t logTime, const std::atomic<bool>* stop);
@@ -113,11 +117,16 @@ class SensorReplay {
   bool step(const Handlers& handlers, const std::atomic<bool>* stop = nullptr);
   // Steps until the end or stop.
   void run(const Handlers& handlers, const std::atomic<bool>* stop = nullptr);
+  // Back to the start with fresh decoders and counters: what a new SensorReplay on the same log
+  // (with ReplayOptions::restampFromNs = restampFromNs) gives, without opening and indexing the
+  // file again (that costs a pass over the whole file).
+  void rewind(std::int64_t restampFromNs = 0);
 
   LogSource& source() { return source_; }
   SensorReplayCounters counters() const;
 
  private:
+  void resetScanDecoder();
   void onSerial(const SerialChunk& chunk, const Handlers& h);
   void drainTelegrams(const Handlers& h, int baud);
 

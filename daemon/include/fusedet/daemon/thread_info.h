@@ -1,0 +1,25 @@
+#pragma once
+// Thread names and CPU times: the daemon's threads carry names (visible in `top -H`, `ps -L`,
+// perf) and its stage timings report CPU time beside wall time, since on a shared machine wall
+// time also counts waiting for a core.
+
+#include <string>
+#include <vector>
+
+namespace fusedet::daemon {
+
+// Names the calling thread (Linux keeps the first 15 characters).
+void nameThisThread(const std::string& name);
+
+// CPU time the calling thread has used, in milliseconds (CLOCK_THREAD_CPUTIME_ID).
+double threadCpuMs();
+
+struct ThreadCpu {
+  int tid = 0;
+  std::string name;
+  double cpuMs = 0;  // user + system time so far
+};
+// Every thread of this process (/proc/self/task), in tid order; empty if /proc is unreadable.
+std::vector<ThreadCpu> processThreadCpu();
+
+}  // namespace fusedet::daemon
