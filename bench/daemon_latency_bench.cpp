@@ -152,7 +152,7 @@ int main(int argc, char** argv) {
   row("detection done -> client receives", deliver);
   std::printf("per stack, ms: stack latency close decode+fuse fuse_cpu queue detect detect_cpu deliver detections\n");
   for (const std::string& r : perStack) std::printf("%s\n", r.c_str());
-  std::printf("CPU time per thread during the replay, ms (fd-* = the daemon's threads; unnamed: TBB workers, the bench's client):\n");
+  std::printf("CPU time per thread during the replay, ms (fd-* = the daemon's threads, fd-tbb = TBB workers helping detection; others: the bench's client):\n");
   for (const ThreadCpu& t : threadCpu)
     if (t.cpuMs > 0) std::printf("  %-16s %9.1f\n", t.name.c_str(), t.cpuMs);
   std::printf("bench: compute_p50_ms %.1f\n", percentile(compute, 0.5));

@@ -176,6 +176,9 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
 
 void Pipeline::detectionLoop() {
   nameThisThread("fd-detect");
+  // Made here: TBB observes the arena of the thread that creates the observer, and the scan's
+  // helpers work in this thread's arena.
+  const TbbWorkerNames helpers("fd-tbb");
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
   const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;
   while (!abandon_) {

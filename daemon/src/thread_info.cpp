@@ -1,6 +1,7 @@
 #include "fusedet/daemon/thread_info.h"
 
 #include <pthread.h>
+#include <tbb/task_scheduler_observer.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,6 +13,21 @@
 namespace fusedet::daemon {
 
 void nameThisThread(const std::string& name) { ::pthread_setname_np(::pthread_self(), name.substr(0, 15).c_str()); }
+
+class TbbWorkerNames::Observer : public tbb::task_scheduler_observer {
+ public:
+  explicit Observer(std::string name) : name_(std::move(name)) { observe(true); }
+  ~Observer() override { observe(false); }
+  void on_scheduler_entry(bool worker) override {
+    if (worker) nameThisThread(name_);
+  }
+
+ private:
+  std::string name_;
+};
+
+TbbWorkerNames::TbbWorkerNames(std::string name) : observer_(std::make_unique<Observer>(std::move(name))) {}
+TbbWorkerNames::~TbbWorkerNames() = default;
 
 double threadCpuMs() {
   timespec t{};

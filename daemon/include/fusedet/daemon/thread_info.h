@@ -3,6 +3,7 @@
 // perf) and its stage timings report CPU time beside wall time, since on a shared machine wall
 // time also counts waiting for a core.
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,21 @@ void nameThisThread(const std::string& name);
 
 // CPU time the calling thread has used, in milliseconds (CLOCK_THREAD_CPUTIME_ID).
 double threadCpuMs();
+
+// While it lives, TBB's worker threads that work in the creating thread's arena (the detection
+// scan's helpers) are named `name`; they would otherwise carry the name of whichever thread
+// first started TBB work.
+class TbbWorkerNames {
+ public:
+  explicit TbbWorkerNames(std::string name);
+  ~TbbWorkerNames();
+  TbbWorkerNames(const TbbWorkerNames&) = delete;
+  TbbWorkerNames& operator=(const TbbWorkerNames&) = delete;
+
+ private:
+  class Observer;
+  std::unique_ptr<Observer> observer_;
+};
 
 struct ThreadCpu {
   int tid = 0;
