@@ -89,8 +89,10 @@ void ReplaySource::run(SensorSink& sink) {
     spdlog::info("replay {}: end of log (pass {})", settings_.log.string(), passes_);
     if (!settings_.loop) break;
     // Faster than the clock, a pass restamped to "now" would go back in time behind the last one
-    // (sweeps cut short at the seam, frames left unpaired): continue after its newest stamp.
-    options_.restampFromNs = newest + 50'000'000;  // past the last scan's beams (13 ms at 75 Hz)
+    // (sweeps cut short at the seam, frames left unpaired): continue after its newest stamp. At
+    // recorded speed the stamps never ran ahead of the clock and "now" is already after them: a
+    // margin there would stamp the whole next pass ahead of the clock (latencies too short).
+    options_.restampFromNs = newest >= Stamp::now().ns ? newest + 50'000'000 : 0;  // 50 ms: past the last scan's beams
     // Rewound, not reopened: opening indexes the whole file (~0.1 s of CPU for the demo log),
     // which would compete with the detection of the pass's last stack.
     replay_->rewind(options_.restampFromNs);

@@ -208,6 +208,13 @@ TEST(Replay, RewoundReplayRepeatsTheFirstPassWithFreshCounters) {
   late.rewind();
   late.run(hd);
   EXPECT_GE(d.scans[0].stamp.ns - firstPass, 50'000'000);
+  // ... or from a given time (a looping replay that ran ahead of the clock).
+  const std::int64_t from = Stamp::now().ns + 3'600'000'000'000;
+  d = {};
+  late.rewind(from);
+  late.run(hd);
+  EXPECT_GE(d.scans[0].stamp.ns, from);
+  EXPECT_LT(d.scans[0].stamp.ns, from + 1'000'000'000);
 }
 
 TEST(Replay, RealtimePacingAndStop) {
