@@ -14,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
 #include <sstream>
@@ -58,7 +59,8 @@ struct ExperimentOptions {
   // Training; 0 = the preset of --quick or the full run.
   int grid = 0, maxStages = 0, maxWeak = 0;
   double targetFalseAlarm = 0;
-  std::size_t negatives = 0;
+  std::optional<std::size_t> negatives;  // 0 = the trainer's rule, max(500, 2 x positives)
+  double trainScaleFactor = 0, trainStep = 0;
   double scaleFactor = 0;
   double step = 0;
   int minNeighbors = 3;
@@ -196,7 +198,9 @@ Preset presetFor(const ExperimentOptions& o) {
   if (o.maxStages > 0) p.maxStages = o.maxStages;
   if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
   if (o.targetFalseAlarm > 0) p.targetFalseAlarm = o.targetFalseAlarm;
-  if (o.negatives > 0) p.negatives = o.negatives;
+  if (o.negatives) p.negatives = *o.negatives;
+  if (o.trainScaleFactor > 0) p.trainScaleFactor = o.trainScaleFactor;
+  if (o.trainStep > 0) p.trainStep = o.trainStep;
   if (o.scaleFactor > 0) p.scaleFactor = o.scaleFactor;
   if (o.step > 0) p.step = o.step;
   if (o.folds >= 0) p.folds = o.folds;
@@ -704,7 +708,13 @@ const bool registered = registerCommand(
       app.add_option("--max-stages", o->maxStages, "stage limit (default: 8, quick 4)");
       app.add_option("--max-weak", o->maxWeak, "stumps per stage at most (default: 15, quick 5)");
       app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-4, quick 1e-3)");
-      app.add_option("--negatives", o->negatives, "negatives per stage (default: 300, quick 200)");
+      app.add_option("--negatives", o->negatives,
+                     "negatives per stage; 0 = the trainer's rule, max(500, 2 x positives), as `fusedet train` "
+                     "(default: 300, quick 200)");
+      app.add_option("--train-scale-factor", o->trainScaleFactor,
+                     "scale step of the training scan that bootstraps negatives (default: 1.25, quick 1.5)");
+      app.add_option("--train-step", o->trainStep,
+                     "position step of that scan, in base-window pixels (default: 3, quick 6)");
       app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.2, quick 1.3)");
       app.add_option("--step", o->step, "detection position step in base-window pixels (default: 3, quick 4)");
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
