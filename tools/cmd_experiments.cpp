@@ -31,6 +31,7 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/fusion/kitti_drives.h"
 #include "fusedet/fusion/kitti_import.h"
+#include "fusedet/fusion/layer_sources.h"
 
 namespace fusedet::tools {
 namespace {
@@ -75,20 +76,30 @@ struct TrainedConfig {
   std::vector<std::string> layers;
   std::string types;  // feature letters
 };
+// "channels" goes beyond the paper: the same joint pool offered the extra channels of
+// fusion/channel_layers.h as well (the data set is then imported with them).
 const std::vector<TrainedConfig>& trainedConfigs() {
-  static const std::vector<TrainedConfig> c = {
-      {"all", {"red", "green", "blue", "intensity", "hue_distance", "distance", "remission"}, "a-j"},
-      {"no_corners", {"red", "green", "blue", "intensity", "hue_distance", "distance", "remission"}, "a-f"},
-      {"laser", {"distance", "remission"}, "a-j"},
-      {"camera", {"intensity", "hue_distance"}, "a-j"},
-      {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
-  };
+  static const std::vector<TrainedConfig> c = [] {
+    std::vector<std::string> withChannels = fusion::paperPoolLayers();
+    withChannels.insert(withChannels.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
+    return std::vector<TrainedConfig>{
+        {"all", fusion::paperPoolLayers(), "a-j"},
+        {"no_corners", fusion::paperPoolLayers(), "a-f"},
+        {"laser", {"distance", "remission"}, "a-j"},
+        {"camera", {"intensity", "hue_distance"}, "a-j"},
+        {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
+        {"channels", withChannels, "a-j"},
+    };
+  }();
   return c;
 }
 const TrainedConfig& trainedConfig(const std::string& name) {
   for (const TrainedConfig& t : trainedConfigs())
     if (t.name == name) return t;
-  throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and)");
+  throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and, channels)");
+}
+bool wantsChannels(const ExperimentOptions& o) {
+  return std::find(o.configs.begin(), o.configs.end(), "channels") != o.configs.end();
 }
 
 std::string shortNum(double v) {
@@ -140,6 +151,9 @@ fs::path resolveDataset(const ExperimentOptions& o) {
   const fs::path cache = o.datasetCache.empty() ? o.out / "dataset" : o.datasetCache;
   std::string signature;
   for (const auto& d : drives) signature += fs::absolute(d).lexically_normal().string() + "\n";
+  fusion::KittiImportOptions import;
+  import.projection.extraChannels = wantsChannels(o);
+  if (import.projection.extraChannels) signature += "with channels\n";
   const fs::path marker = cache / "imported-from.txt";
   if (std::ifstream in(marker); in) {
     std::stringstream s;
@@ -152,7 +166,7 @@ fs::path resolveDataset(const ExperimentOptions& o) {
   fs::remove_all(cache);
   for (const fs::path& d : drives) {
     const std::string group = d.filename().string();
-    const auto stats = fusion::importKitti(d, group, cache, fusion::KittiImportOptions{});
+    const auto stats = fusion::importKitti(d, group, cache, import);
     std::printf("imported %s -> group %s: %zu frames, %zu labels (%zu ignore regions)\n", d.c_str(),
                 group.c_str(), stats.frames, stats.labels, stats.ignoreRegions);
   }
@@ -245,8 +259,10 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const Preset& p, const 
   return spec;
 }
 
-std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries) {
-  static const std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
+std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
+                                   bool channels) {
+  std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
+  if (channels) layers.insert(layers.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
   std::vector<DatasetItem> items;
   items.reserve(entries.size());
   for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(dataset, e.id, layers));
@@ -382,7 +398,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  const std::vector<DatasetItem> items = loadItems(dataset, manifest);
+  const std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(o));
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -479,6 +495,7 @@ int runExperiments(ExperimentOptions o) {
       claim("joint_gt_and", "joint pool (all layers) > laser AND camera", "all", "and");
       claim("four_gt_and", "joint pool (4 layers) > laser AND camera", "four", "and");
       claim("corners_help", "corner features help (all > all without corners)", "all", "no_corners");
+      claim("channels_help", "extra channels help (joint pool + channels > all)", "channels", "all");
       if (cls == "person") claim("joint_gt_hog", "joint pool (all layers) > OpenCV HOG", "all", "hog");
       std::vector<Series> pr;
       for (const ConfigResult& r : report.results) {
@@ -567,9 +584,9 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if (config == "all" && !r.layerWeightShare.empty())
-      cv::imwrite((o.out / ("weight_share_" + cls + ".png")).string(),
-                  weightShareChart(cls + ": weight share by layer (all layers, all folds)", r.layerWeightShare));
+    if ((config == "all" || config == "channels") && !r.layerWeightShare.empty())
+      cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
+                  weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
   };
 
   // Phase 1, the headline: the joint pool of every class. Phase 2: the paper's other
@@ -674,7 +691,9 @@ const bool registered = registerCommand(
       app.add_option("--configs", o->configs,
                      "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
                      "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
-                     "remission), and (laser AND camera; trains both)")
+                     "remission), and (laser AND camera; trains both), channels (beyond the paper: all seven "
+                     "layers + grad_mag, grad_0..5, height, distance_grad, features a-j; the KITTI drives are "
+                     "then imported with `import-kitti --channels`; not in the default list)")
           ->delimiter(',')
           ->capture_default_str();
       app.add_option("--van", o->van,

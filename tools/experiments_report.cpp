@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 
 #include "fusedet/core/layer_stack.h"
+#include "fusedet/fusion/layer_sources.h"
 
 namespace fusedet::tools::experiments {
 namespace {
@@ -76,6 +78,8 @@ const std::vector<ConfigInfo>& paperConfigs() {
       {"camera", "Tab. 5: camera only (intensity, hue distance)"},
       {"four", "Tab. 6: hue distance, intensity, distance, remission"},
       {"and", "Tab. 7: laser-only AND camera-only cascade (Tab. 4 AND Tab. 5; a detection must pass both)"},
+      {"channels", "beyond the paper: joint pool + channels (the seven layers of Tab. 2 and grad_mag, grad_0..5, "
+                   "height, distance_grad), features a-j"},
   };
   return c;
 }
@@ -85,12 +89,26 @@ std::vector<std::string> orderedLayers(const std::map<std::string, double>& shar
                                           std::string(layer::kBlue),        std::string(layer::kHueDistance),
                                           std::string(layer::kIntensity),   std::string(layer::kDistance),
                                           std::string(layer::kRemission)};
+  std::vector<std::string> known = paper;
+  known.insert(known.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
   std::vector<std::string> out;
-  for (const auto& l : paper)
+  for (const auto& l : known)
     if (shares.count(l)) out.push_back(l);
   for (const auto& [l, s] : shares)
-    if (std::find(paper.begin(), paper.end(), l) == paper.end()) out.push_back(l);
+    if (std::find(known.begin(), known.end(), l) == known.end()) out.push_back(l);
   return out;
+}
+
+std::vector<std::string> orderedSources(const std::set<std::string>& sources) {
+  std::vector<std::string> out;
+  for (const auto s : {fusion::LayerSource::camera, fusion::LayerSource::laser, fusion::LayerSource::cameraDerived,
+                       fusion::LayerSource::laserDerived, fusion::LayerSource::unknown})
+    if (sources.count(fusion::toString(s))) out.push_back(fusion::toString(s));
+  return out;
+}
+
+std::string weightShareChartName(const std::string& cls, const std::string& config) {
+  return config == "all" ? "weight_share_" + cls + ".png" : "weight_share_" + config + "_" + cls + ".png";
 }
 
 std::string renderMarkdown(const ExperimentReport& r) {
@@ -210,36 +228,56 @@ std::string renderMarkdown(const ExperimentReport& r) {
     md << "\n";
   }
 
-  md << "## Weight share by layer (paper Fig. 7)\n\n"
-        "Cascades of configuration `all`, all folds together. The weight of a stump is |right - left|: "
-        "the amount it moves the stage sum between its two sides. Shares are weights summed per layer, "
-        "divided by the total.\n\n";
-  {
+  const auto weightShares = [&](const std::string& config, const std::string& heading) {
+    std::vector<const ConfigResult*> results;
     std::map<std::string, double> allLayers;
     for (const std::string& cls : r.classes)
-      if (const ConfigResult* c = find(r, cls, "all"))
+      if (const ConfigResult* c = find(r, cls, config); c && !c->layerWeightShare.empty()) {
+        results.push_back(c);
         for (const auto& [l, s] : c->layerWeightShare) allLayers[l] += s;
+      }
+    if (results.empty()) return;
+    md << heading << "Cascades of configuration `" << config
+       << "`, all folds together. The weight of a stump is |right - left|: the amount it moves the stage sum "
+          "between its two sides. Shares are weights summed per layer, divided by the total; the second "
+          "table sums them per source (fusion/layer_sources.h: camera = red, green, blue, intensity, hue "
+          "distance; laser = distance, remission; camera (derived) = gradient channels of intensity; laser "
+          "(derived) = height above the ground plane, depth gradient).\n\n";
     const std::vector<std::string> layers = orderedLayers(allLayers);
     std::vector<std::string> header{"class"};
     header.insert(header.end(), layers.begin(), layers.end());
     header.push_back("corner features");
-    std::vector<std::vector<std::string>> body;
-    for (const std::string& cls : r.classes) {
-      const ConfigResult* c = find(r, cls, "all");
-      if (!c) continue;
-      std::vector<std::string> line{cls};
+    std::vector<std::vector<std::string>> body, sourceBody;
+    std::set<std::string> sources;
+    for (const ConfigResult* c : results)
+      for (const auto& [src, s] : fusion::sharesBySource(c->layerWeightShare)) sources.insert(src);
+    const std::vector<std::string> sourceOrder = orderedSources(sources);
+    for (const ConfigResult* c : results) {
+      std::vector<std::string> line{c->className};
       for (const auto& l : layers) {
         const auto it = c->layerWeightShare.find(l);
         line.push_back(num(it == c->layerWeightShare.end() ? 0.0 : 100 * it->second, 1) + " %");
       }
       line.push_back(num(100 * c->cornerShare, 0) + " %");
       body.push_back(line);
+      const auto bySource = fusion::sharesBySource(c->layerWeightShare);
+      std::vector<std::string> sl{c->className};
+      for (const auto& src : sourceOrder) {
+        const auto it = bySource.find(src);
+        sl.push_back(num(it == bySource.end() ? 0.0 : 100 * it->second, 1) + " %");
+      }
+      sourceBody.push_back(sl);
     }
-    if (!body.empty()) table(md, header, body);
-    for (const std::string& cls : r.classes)
-      if (find(r, cls, "all")) md << "![weight share " << cls << "](weight_share_" << cls << ".png)\n";
+    table(md, header, body);
+    std::vector<std::string> sourceHeader{"class"};
+    sourceHeader.insert(sourceHeader.end(), sourceOrder.begin(), sourceOrder.end());
+    table(md, sourceHeader, sourceBody);
+    for (const ConfigResult* c : results)
+      md << "![weight share " << c->className << "](" << weightShareChartName(c->className, config) << ")\n";
     md << "\n";
-  }
+  };
+  weightShares("all", "## Weight share by layer (paper Fig. 7)\n\n");
+  weightShares("channels", "## Weight share by layer and sensor: joint pool + channels\n\n");
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";
@@ -294,6 +332,7 @@ json toJson(const ExperimentReport& r) {
       e["cached_folds"] = c.cachedFolds;
       e["train_seconds"] = c.trainSeconds;
       e["layer_weight_share"] = c.layerWeightShare;
+      e["source_weight_share"] = fusion::sharesBySource(c.layerWeightShare);
       e["corner_share"] = c.cornerShare;
     }
     j["results"].push_back(std::move(e));

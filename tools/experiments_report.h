@@ -9,6 +9,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <opencv2/core/mat.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -96,8 +97,13 @@ struct ConfigInfo {
 };
 const std::vector<ConfigInfo>& paperConfigs();
 
-// Layer order for charts and tables: the paper's Fig. 3 order, unknown layers after it.
+// Layer order for charts and tables: the paper's Fig. 3 order, then the extra channels
+// (fusion/layer_sources.h), unknown layers after them.
 std::vector<std::string> orderedLayers(const std::map<std::string, double>& shares);
+// Source names (fusion::toString(LayerSource)) in the order camera, laser, derived, other.
+std::vector<std::string> orderedSources(const std::set<std::string>& sources);
+// weight_share_<class>.png for `all` (paper Fig. 7), weight_share_<config>_<class>.png otherwise.
+std::string weightShareChartName(const std::string& cls, const std::string& config);
 
 // "0.58 [0.41, 0.72]", "null" when undefined.
 std::string formatEstimate(const Estimate& e, int decimals = 2);
