@@ -1,5 +1,5 @@
 // Sensor-stamp-to-socket latency of the whole daemon replaying a sensor log: a log synthesised
-// from held-back KITTI frames (raw LMS telegrams, CANopen tilt traffic, YUYV camera frames) is
+// from KITTI frames of the last third of drive 0005 (raw LMS telegrams, CANopen tilt traffic, YUYV camera frames) is
 // replayed at recorded speed and re-stamped to "now" (as if the sensors were live) into a running
 // Service - live decoders, sweep assembly, pairing, fusion, the car, bike and person cascades, the
 // socket server - and a socket client measures (receive time - sensor stamp of the stack). Beside
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
   app.add_option("--data", data, "root of the shared data (the log is made from its kitti/ folder)")->capture_default_str();
   app.add_option("--models", models, "folder with car.json, bike.json, person.json")->capture_default_str();
   app.add_option("--log", log, "replay this sensor log instead of synthesising one");
-  app.add_option("--frames", frames, "strokes of the synthesised log (one held-back KITTI frame each)")->capture_default_str();
+  app.add_option("--frames", frames, "strokes of the synthesised log (one KITTI frame each)")->capture_default_str();
   app.add_option("--passes", passes, "times the log is replayed")->capture_default_str();
   app.add_option("--speed", speed, "replay speed (1 = as recorded)")->capture_default_str();
   app.add_option("--threads", threads, "detection threads (0 = all cores)")->capture_default_str();

@@ -93,7 +93,7 @@ struct Args {
 Args parse(int argc, char** argv) {
   Args a;
   CLI::App app{
-      "bench_detect3 - the three bundled models on the first held-back frame of the drive (fused), one pass, vs\n"
+      "bench_detect3 - the three bundled models on the demo frame, the first of the drive's last third (fused), one pass, vs\n"
       "the previous per-class path and vs OpenCV's frontalface_default on the intensity layer, rounds\n"
       "interleaved; medians of thread CPU time."};
   bool smoke = false;
@@ -117,7 +117,7 @@ Args parse(int argc, char** argv) {
 int main(int argc, char** argv) try {
   const Args a = parse(argc, argv);
   cv::setNumThreads(1);
-  // The demo's frame: the first of the drive's held-back last third.
+  // The demo's frame: the first of the drive's last third (a training frame of the models).
   const fs::path root = a.data / a.drive;
   const std::vector<std::string> ids = fusion::listKittiFrames(root);
   if (ids.empty()) throw std::runtime_error(root.string() + ": no frames");

@@ -73,7 +73,7 @@ const bool registered = registerCommand(
       app.add_option("--out", o->out, "the MCAP log to write")->required();
       app.add_flag("--procedural", o->procedural, "ignore KITTI: a procedural scene of known geometry (ground, boxes, wall)");
       app.add_option("--frames", o->synth.frames, "strokes to synthesise, one KITTI frame each")->capture_default_str();
-      app.add_option("--first", o->synth.first, "index of the first KITTI frame (-1: the first of the held-back last third)")
+      app.add_option("--first", o->synth.first, "index of the first KITTI frame (-1: the first of the drive's last third)")
           ->capture_default_str();
       app.add_option("--camera-fps", o->synth.cameraFps, "camera frame rate")->capture_default_str();
       app.add_flag("--derived", o->derived,

@@ -1,6 +1,6 @@
 #pragma once
 // Sensor logs for the daemon tests: synthesised at run time by the synth-log library from the
-// held-back KITTI frames in ../shared/data (procedural scene when there is no KITTI data) and kept
+// KITTI frames (last third of drive 0005) in ../shared/data (procedural scene when there is no KITTI data) and kept
 // in build/logs/ (never in the source tree: KITTI licence). A log older than the test binary is
 // made again, so a changed synthesiser never leaves a stale cache behind.
 

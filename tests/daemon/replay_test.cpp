@@ -1,4 +1,4 @@
-// The daemon replaying a sensor log (synthesised from held-back KITTI frames; procedural without
+// The daemon replaying a sensor log (synthesised from KITTI frames of the last third of drive 0005; procedural without
 // KITTI data) through its real pipeline - live decoders, sweep assembly, pairing, fusion, the
 // bundled cascades, the socket server: deterministic as-fast-as-possible replays, 50 mixed
 // clients at once with nothing lost for those that keep up, damaged logs.
@@ -133,7 +133,7 @@ TEST(ReplayService, AsFastAsPossibleEveryStrokeIsDetectedAndTwoRunsAgree) {
       EXPECT_GT(d["camera"][2].get<double>(), 0.0) << "in front of the camera";
     }
   }
-  // The bundled models find something in the held-back KITTI frames (the demo relies on it).
+  // The bundled models find something in those KITTI frames (training frames of theirs) (the demo relies on it).
   if (testlogs::haveKitti()) {
     EXPECT_GT(found, 0u);
   }

@@ -28,7 +28,7 @@ std::vector<Cascade> bundledModels() {
   return out;
 }
 
-// Real fused stacks: the first frame and one of the held-back third of both shared drives.
+// Real fused stacks: the first frame and one of the last third of both shared drives.
 const std::vector<LayerStack>& kittiStacks() {
   static const std::vector<LayerStack> stacks = [] {
     std::vector<LayerStack> out;

@@ -41,7 +41,7 @@ namespace fusedet::fusion {
 struct SynthOptions {
   std::filesystem::path kitti;  // KITTI-layout directory; empty = procedural scene
   int frames = 6;               // strokes (one KITTI frame each)
-  int first = -1;               // index into listKittiFrames; -1 = first frame of the held-back last third
+  int first = -1;               // index into listKittiFrames; -1 = first frame of the drive's last third
   double cameraFps = 5;
   double toleranceDeg = 0.4;    // beam <-> Velodyne point angular tolerance
   Stamp start{1'000'000'000'000};  // stamp of the first message (CLOCK_MONOTONIC-like)
