@@ -22,8 +22,8 @@ struct Source {
 };
 
 // Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum
-// (squared: rowSum += v * v in double, as its squared sums).
-template <class T, class Acc>
+// (kSquared: rowSum += v * v in double, as its squared sums).
+template <class T, class Acc, bool kSquared = false>
 void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
   const int w = data.cols, h = data.rows;
   for (int y = 0; y < h; ++y) {
@@ -32,28 +32,15 @@ void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
     Acc* cur = slot0 + (y + 1) * pitch;
     Acc rowSum = 0;
     for (int x = 0; x < w; ++x) {
-      rowSum += static_cast<Acc>(row[x]);
-      cur[x + 1] = prev[x + 1] + rowSum;
-    }
-  }
-}
-template <class T>
-void integrateSquares(const cv::Mat& data, double* slot0, std::ptrdiff_t pitch) {
-  const int w = data.cols, h = data.rows;
-  for (int y = 0; y < h; ++y) {
-    const T* row = data.ptr<T>(y);
-    const double* prev = slot0 + y * pitch;
-    double* cur = slot0 + (y + 1) * pitch;
-    double rowSum = 0;
-    for (int x = 0; x < w; ++x) {
-      const double v = static_cast<double>(row[x]);
-      rowSum += v * v;
+      const Acc v = static_cast<Acc>(row[x]);
+      rowSum += kSquared ? v * v : v;
       cur[x + 1] = prev[x + 1] + rowSum;
     }
   }
 }
 
-void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, bool squared, double* slot0,
+template <bool kSquared>
+void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, double* slot0,
                           std::ptrdiff_t pitch) {
   const int w = hue.cols, h = hue.rows;
   std::vector<float> dist(static_cast<std::size_t>(w));
@@ -65,7 +52,7 @@ void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double refer
     double rowSum = 0;
     for (int x = 0; x < w; ++x) {
       const double v = static_cast<double>(dist[static_cast<std::size_t>(x)]);
-      rowSum += squared ? v * v : v;
+      rowSum += kSquared ? v * v : v;
       cur[x + 1] = prev[x + 1] + rowSum;
     }
   }
@@ -77,12 +64,14 @@ bool fitsInt32(const cv::Mat& data) {
 }
 
 void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
-  if (s.hueReference) return integrateHueDistance(s.data, s.hueValid, *s.hueReference, s.squared, slot0, pitch);
+  if (s.hueReference)
+    return s.squared ? integrateHueDistance<true>(s.data, s.hueValid, *s.hueReference, slot0, pitch)
+                     : integrateHueDistance<false>(s.data, s.hueValid, *s.hueReference, slot0, pitch);
   if (s.squared) switch (s.data.depth()) {
-      case CV_8U: return integrateSquares<std::uint8_t>(s.data, slot0, pitch);
-      case CV_16U: return integrateSquares<std::uint16_t>(s.data, slot0, pitch);
-      case CV_32F: return integrateSquares<float>(s.data, slot0, pitch);
-      case CV_64F: return integrateSquares<double>(s.data, slot0, pitch);
+      case CV_8U: return integrateSlot<std::uint8_t, double, true>(s.data, slot0, pitch);
+      case CV_16U: return integrateSlot<std::uint16_t, double, true>(s.data, slot0, pitch);
+      case CV_32F: return integrateSlot<float, double, true>(s.data, slot0, pitch);
+      case CV_64F: return integrateSlot<double, double, true>(s.data, slot0, pitch);
       default: throw std::invalid_argument("IntegralGrids: layer depth must be 8U, 16U, 32F or 64F");
     }
   switch (s.data.depth()) {

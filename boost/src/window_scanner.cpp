@@ -36,8 +36,8 @@ struct GridStump {
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
   float threshold = 0;
+  int contrast = -1;  // contrast-normalised: index into GridScale::contrasts, else -1 (fills padding)
   double left = 0, right = 0;
-  int contrast = -1;  // contrast-normalised: index into GridScale::contrasts, else -1
 };
 
 // The contrast (feature.h: windowContrast) of one normalised layer on a window: the layer window's
@@ -183,9 +183,12 @@ struct WindowList {
     for (std::size_t c = 0; c < contrasts; ++c)
       for (std::size_t k = n; k < n + kPad; ++k) contrastOf(c)[k] = 1.0;
   }
+  // kContrast: the windows carry contrasts (models without any skip the loop in the hot path).
+  template <bool kContrast = true>
   void keep(std::size_t from, std::size_t to, double s) {
     for (std::size_t g = 0; g < grids; ++g) offsets(g)[to] = offsets(g)[from];
-    for (std::size_t c = 0; c < contrasts; ++c) contrastOf(c)[to] = contrastOf(c)[from];
+    if constexpr (kContrast)
+      for (std::size_t c = 0; c < contrasts; ++c) contrastOf(c)[to] = contrastOf(c)[from];
     xi[to] = xi[from];
     yi[to] = yi[from];
     score[to] = s;

@@ -28,6 +28,36 @@ class Recorder : public ProgressSink {
   std::vector<ProgressEvent> events;
 };
 
+// Raw hits of `det` on six unseen scenes (changed by `alter` first): cars found at IoU >= 0.5.
+struct Found {
+  std::size_t found = 0, cars = 0, hits = 0, windows = 0;
+};
+template <class Alter>
+Found findCars(const Detector& det, const Alter& alter) {
+  ScanParams p;
+  p.scaleFactor = 1.1;
+  p.step = 1;
+  Found f;
+  for (unsigned s = 900; s < 906; ++s) {
+    DatasetItem t = scene(s, 2, false);
+    alter(t);
+    ScanStats stats;
+    const auto raw = det.scan(t.stack, p, &stats);
+    f.windows += stats.windows;
+    f.hits += raw.size();
+    for (const Label& l : t.labels) {
+      if (l.className != "car") continue;
+      ++f.cars;
+      for (const RawHit& h : raw)
+        if (iou(h.box, l.box) >= 0.5) {
+          ++f.found;
+          break;
+        }
+    }
+  }
+  return f;
+}
+
 }  // namespace
 
 TEST(CascadeTrainer, LearnsSyntheticCarsAndReportsItsStop) {
@@ -54,29 +84,9 @@ TEST(CascadeTrainer, LearnsSyntheticCarsAndReportsItsStop) {
   EXPECT_EQ(rec.events.back().kind, ProgressKind::kFinished);
 
   // On unseen scenes: every car found at IoU >= 0.5 among the raw hits, few windows accepted.
-  const Detector det(c);
-  ScanParams p;
-  p.scaleFactor = 1.1;
-  p.step = 1;
-  std::size_t found = 0, cars = 0, hits = 0, windows = 0;
-  for (unsigned s = 900; s < 906; ++s) {
-    const DatasetItem t = scene(s, 2, false);
-    ScanStats stats;
-    const auto raw = det.scan(t.stack, p, &stats);
-    windows += stats.windows;
-    hits += raw.size();
-    for (const Label& l : t.labels) {
-      if (l.className != "car") continue;
-      ++cars;
-      for (const RawHit& h : raw)
-        if (iou(h.box, l.box) >= 0.5) {
-          ++found;
-          break;
-        }
-    }
-  }
-  EXPECT_GE(double(found), 0.8 * double(cars)) << found << " of " << cars << "; " << report.stopReason;
-  EXPECT_LT(double(hits) / double(windows), 0.05);
+  const Found f = findCars(Detector(c), [](DatasetItem&) {});
+  EXPECT_GE(double(f.found), 0.8 * double(f.cars)) << f.found << " of " << f.cars << "; " << report.stopReason;
+  EXPECT_LT(double(f.hits) / double(f.windows), 0.05);
 }
 
 TEST(CascadeTrainer, SameSeedSameDataGivesByteIdenticalModelForAnyThreadCount) {
@@ -292,32 +302,13 @@ TEST(CascadeTrainer, ContrastNormalisedTrainingIsRecordedAndSurvivesAGainChange)
   ASSERT_EQ(c.contrastNormalised, std::vector<bool>{true});
   const Cascade back = modelFromText(modelToText(c), "n.json");
   EXPECT_EQ(back.contrastNormalised, c.contrastNormalised);
-  const Detector det(back);
-  ScanParams p;
-  p.scaleFactor = 1.1;
-  p.step = 1;
-  std::size_t found = 0, cars = 0, hits = 0, windows = 0;
-  for (unsigned s = 900; s < 906; ++s) {
-    DatasetItem t = scene(s, 2, false);
+  const Found f = findCars(Detector(back), [](DatasetItem& t) {
     cv::Mat dim;
     t.stack.at("intensity").data.convertTo(dim, CV_8U, 0.5, 40);
     t.stack.set(Layer{"intensity", dim, {}});
-    ScanStats stats;
-    const auto raw = det.scan(t.stack, p, &stats);
-    windows += stats.windows;
-    hits += raw.size();
-    for (const Label& l : t.labels) {
-      if (l.className != "car") continue;
-      ++cars;
-      for (const RawHit& h : raw)
-        if (iou(h.box, l.box) >= 0.5) {
-          ++found;
-          break;
-        }
-    }
-  }
-  EXPECT_GE(double(found), 0.8 * double(cars)) << found << " of " << cars << "; " << report.stopReason;
-  EXPECT_LT(double(hits) / double(windows), 0.05);
+  });
+  EXPECT_GE(double(f.found), 0.8 * double(f.cars)) << f.found << " of " << f.cars << "; " << report.stopReason;
+  EXPECT_LT(double(f.hits) / double(f.windows), 0.05);
   // A layer that is not in the pool is refused.
   config.pool.contrastNormalised = {"distance"};
   EXPECT_THROW(trainCascade(config, items, quiet), std::invalid_argument);

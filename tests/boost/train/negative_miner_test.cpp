@@ -83,17 +83,21 @@ void expectSameHarvest(const NegativeHarvest& got, const NegativeHarvest& want, 
   }
 }
 
+// `config` trained with the full rescan (first) and with the incremental miner (second).
+std::pair<Cascade, Cascade> trainBothWays(TrainingConfig config, TrainingReport& rescanReport,
+                                          TrainingReport& minerReport) {
+  NullProgress quiet;
+  config.incrementalMining = false;
+  Cascade rescan = trainCascade(config, kittiItems(), quiet, &rescanReport);
+  config.incrementalMining = true;
+  return {std::move(rescan), trainCascade(config, kittiItems(), quiet, &minerReport)};
+}
+
 }  // namespace
 
 TEST(NegativeMiner, TrainsTheSameModelAsTheFullRescanOnRealKittiFrames) {
-  TrainingConfig rescan = smallCarConfig();
-  rescan.incrementalMining = false;
-  TrainingConfig incremental = smallCarConfig();
-  incremental.incrementalMining = true;
-  NullProgress quiet;
   TrainingReport a, b;
-  const Cascade old = trainCascade(rescan, kittiItems(), quiet, &a);
-  const Cascade fast = trainCascade(incremental, kittiItems(), quiet, &b);
+  const auto [old, fast] = trainBothWays(smallCarConfig(), a, b);
   ASSERT_GE(old.stages.size(), 3u) << a.stopReason;
   EXPECT_EQ(modelToText(fast), modelToText(old));
   ASSERT_EQ(b.stages.size(), a.stages.size());
@@ -163,16 +167,11 @@ TEST(NegativeMiner, LabelTestEqualsTheLabelByLabelRule) {
 // With a contrast-normalised layer the miner (per-window contrasts from the squared sums) still
 // trains the rescan's model, byte for byte.
 TEST(NegativeMiner, TrainsTheSameContrastNormalisedModelAsTheFullRescan) {
-  TrainingConfig rescan = smallCarConfig();
-  rescan.pool.contrastNormalised = {"intensity"};
-  rescan.maxStages = 4;
-  rescan.incrementalMining = false;
-  TrainingConfig incremental = rescan;
-  incremental.incrementalMining = true;
-  NullProgress quiet;
+  TrainingConfig config = smallCarConfig();
+  config.pool.contrastNormalised = {"intensity"};
+  config.maxStages = 4;
   TrainingReport a, b;
-  const Cascade old = trainCascade(rescan, kittiItems(), quiet, &a);
-  const Cascade fast = trainCascade(incremental, kittiItems(), quiet, &b);
+  const auto [old, fast] = trainBothWays(config, a, b);
   ASSERT_GE(old.stages.size(), 3u) << a.stopReason;
   ASSERT_EQ(old.contrastNormalised, (std::vector<bool>{true, false, false}));
   EXPECT_EQ(modelToText(fast), modelToText(old));
