@@ -195,7 +195,8 @@ const bool registered = registerCommand(
                      "OpenCV grouping: a detection needs more than this many raw hits; 0 = report raw hits "
                      "ungrouped (default 3, as OpenCV)");
       app.add_option("--min-size", o->minSize,
-                     "smallest window WxH in image pixels (default: none, i.e. the model's base window)");
+                     "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
+                     "smallest training positive, in models that have one - else its base window)");
       app.add_option("--max-size", o->maxSize, "largest window WxH in image pixels (default: the whole image)");
       app.add_option("--group", o->group,
                      "grouping of raw hits: opencv (cv::groupRectangles' rule; score = hits in the group) or nms "

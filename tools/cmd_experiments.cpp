@@ -67,6 +67,9 @@ struct ExperimentOptions {
   int minNeighbors = 3;
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
+  int validationPart = -1;  // -1 = the preset's
+  double validationMinHit = 0.98;
+  bool minHeightFromPositives = false;
   std::string commandLine;
 };
 
@@ -198,6 +201,7 @@ struct Preset {
   double scaleFactor, step;
   int folds;
   std::size_t resamples;
+  int validationPart;  // 0 = off (boost/validation_part.h)
 };
 
 Preset presetFor(const ExperimentOptions& o) {
@@ -206,8 +210,8 @@ Preset presetFor(const ExperimentOptions& o) {
   // training is much lighter than the old within-drive run's (grid 12, 20 stages x 100 stumps,
   // 18.5 min for 15 cascades): here 22 folds x 5 configurations x 3 classes plus the learning
   // curve are ~460 cascades, which must fit about an hour on 2 cores shared with other jobs.
-  Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4, 3, 200}
-                     : Preset{6, 8, 15, 1e-4, 300, 1.25, 3, 1.2, 3, 0, 1000};
+  Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4, 3, 200, 0}
+                     : Preset{6, 8, 15, 1e-4, 300, 1.25, 3, 1.2, 3, 0, 1000, 0};
   if (o.grid > 0) p.grid = o.grid;
   if (o.maxStages > 0) p.maxStages = o.maxStages;
   if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
@@ -219,6 +223,7 @@ Preset presetFor(const ExperimentOptions& o) {
   if (o.step > 0) p.step = o.step;
   if (o.folds >= 0) p.folds = o.folds;
   if (o.resamples > 0) p.resamples = o.resamples;
+  if (o.validationPart >= 0) p.validationPart = o.validationPart;
   return p;
 }
 
@@ -243,6 +248,15 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const Preset
   c.minPositives = o.minPositives;
   c.seed = o.seed;
   c.threads = o.threads;
+  // Validation part: drives of the fold's training drives (items' group = raw drive, loadItems),
+  // detected and scored as the test frames are.
+  c.validation.part = p.validationPart;
+  c.validation.detection.scan.scaleFactor = p.scaleFactor;
+  c.validation.detection.scan.step = p.step;
+  c.validation.detection.group.minNeighbors = o.minNeighbors;
+  c.validation.match = match;
+  c.validation.minHit = o.validationMinHit;
+  c.minHeightFromPositives = o.minHeightFromPositives;
   return c;
 }
 
@@ -259,13 +273,17 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const Preset& p, const 
   return spec;
 }
 
+// Items with their raw drive as group (the trainer's validation part holds back whole drives).
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   bool channels) {
+                                   bool channels, const std::vector<std::string>& driveOf) {
   std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
   if (channels) layers.insert(layers.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
   std::vector<DatasetItem> items;
   items.reserve(entries.size());
-  for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(dataset, e.id, layers));
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    items.push_back(readDatasetItem(dataset, entries[i].id, layers));
+    items.back().group = driveOf[i];
+  }
   return items;
 }
 
@@ -398,7 +416,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  const std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(o));
+  const std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(o), driveOf);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -415,6 +433,14 @@ int runExperiments(ExperimentOptions o) {
       {"target false-alarm rate", shortNum(preset.targetFalseAlarm)},
       {"negatives per stage", preset.negatives ? std::to_string(preset.negatives) : "max(500, 2 x positives)"},
       {"stage min hit / max false alarm", "0.995 / 0.5"},
+      {"validation part", preset.validationPart
+                              ? "1/" + std::to_string(preset.validationPart) +
+                                    " of each fold's training frames (whole drives, smallest first): stage " +
+                                    (o.validationMinHit > 0 ? "thresholds keep " + shortNum(o.validationMinHit) +
+                                                                  " of its positives, "
+                                                            : std::string("thresholds from the training positives, ")) +
+                                    "stage count by its F"
+                              : "none (stage thresholds from the training positives, every trained stage kept)"},
       {"seed (training and bootstrap)", std::to_string(o.seed)},
       {"bootstrap resamples", std::to_string(preset.resamples)},
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
@@ -422,6 +448,8 @@ int runExperiments(ExperimentOptions o) {
       {"grouping", "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors)},
       {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
+      {"minimum detection height", o.minHeightFromPositives ? "smallest training positive (model's min_height)"
+                                                            : "base window"},
       {"fold model cache", cache.string()},
   };
 
@@ -742,6 +770,20 @@ const bool registered = registerCommand(
                      "window's standard deviation of their layer): none, camera (red, green, blue, intensity "
                      "where a configuration has them) or layer names (each configuration normalises those it has)")
           ->capture_default_str();
+      app.add_option("--validation", o->validationPart,
+                     "N >= 2: each fold's trainer holds back about 1/N of its training frames (whole drives, "
+                     "smallest first; never trained on): stage thresholds keep the min hit rate on their "
+                     "positives, and the stage count is the one with the best F on those frames (detected like "
+                     "the test frames); 0 = off (default: 0, also quick). See `fusedet train --validation-part`")
+          ->check(CLI::Range(0, 1000));
+      app.add_option("--validation-min-hit", o->validationMinHit,
+                     "with --validation: share of the held-back positives reaching a stage that it keeps; 0 = "
+                     "thresholds from the training positives (the held-back drives only choose the stage count)")
+          ->check(CLI::Range(0.0, 1.0))
+          ->capture_default_str();
+      app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
+                   "models store their smallest training positive's height as minimum detection height "
+                   "(default: detection scans from the base window)");
       app.add_option("--min-positives", o->minPositives,
                      "training ends when fewer positives than this are still accepted (person data is scarce)")
           ->capture_default_str();

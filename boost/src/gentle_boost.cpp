@@ -17,7 +17,8 @@ double stageThreshold(std::vector<double> scores, double minHit) {
 }
 
 StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
-                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound) {
+                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
+                       const HeldOutPositives* heldOut) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
@@ -28,6 +29,9 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
   std::vector<float> values(n);
+  const std::size_t held = heldOut ? heldOut->count : 0;
+  std::vector<double> heldScore(held, 0.0);
+  std::vector<float> heldValues(held);
   StageResult result;
   for (int round = 1; round <= config.maxWeak; ++round) {
     for (std::size_t i = 0; i < n; ++i) wf[i] = static_cast<float>(w[i]);
@@ -42,9 +46,15 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
     }
     for (double& v : w) v /= sum;
     result.stumps.push_back(s);
-    result.threshold =
+    result.trainingThreshold =
         stageThreshold(std::vector<double>(score.begin(), score.begin() + static_cast<std::ptrdiff_t>(positives)),
                        config.minHit);
+    result.threshold = result.trainingThreshold;
+    if (held > 0) {
+      heldOut->values(s.feature, heldValues);
+      for (std::size_t i = 0; i < held; ++i) heldScore[i] += s(heldValues[i]);
+      result.threshold = stageThreshold(heldScore, heldOut->minHit);
+    }
     std::size_t hits = 0, fas = 0;
     for (std::size_t i = 0; i < n; ++i)
       if (score[i] >= result.threshold) (i < positives ? hits : fas)++;
@@ -61,7 +71,7 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
 
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound) {
+                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut) {
   StumpSearchOptions search;
   search.threads = config.threads;
   search.refineTop = config.refineTop;
@@ -72,7 +82,7 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
         rawValues(s.feature, chosen);
         return s;
       },
-      config, onRound);
+      config, onRound, heldOut);
 }
 
 }  // namespace fusedet::boosting

@@ -103,6 +103,7 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
   if (!normalised.empty()) o << "  \"contrast_normalised\": " << Json(normalised).dump() << ",\n";
+  if (c.minHeight > 0) o << "  \"min_height\": " << c.minHeight << ",\n";  // optional: older files lack it
   if (!info.empty()) {
     Json t = Json::object();
     for (const auto& [k, v] : info) t[k] = v;
@@ -181,6 +182,7 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
     }
     if (cn.empty()) c.contrastNormalised.clear();
   }
+  if (root.contains("min_height")) c.minHeight = r.integer(root, "", "min_height", 0, 1 << 16);
   const Json& stages = r.array(root, "", "stages");
   if (stages.empty()) r.fail("stages", "no stages");
   std::vector<std::pair<Feature, int>> seen;  // features in first-use order (shared by stumps)

@@ -64,6 +64,30 @@ TEST(ModelIo, RoundTripIsExactAndTextIsStable) {
   EXPECT_NE(text.find("\"type\":\"g\""), std::string::npos);
 }
 
+TEST(ModelIo, MinimumDetectionHeightIsOptional) {
+  // Files without "min_height" (every model before it existed) load with 0 = from the base window,
+  // and such a cascade writes no field, so their text is unchanged.
+  const std::string old = modelToText(sample());
+  EXPECT_EQ(old.find("min_height"), std::string::npos);
+  EXPECT_EQ(modelFromText(old, "m.json").minHeight, 0);
+  Cascade c = sample();
+  c.minHeight = 27;
+  const std::string text = modelToText(c);
+  EXPECT_NE(text.find("\"min_height\": 27,"), std::string::npos);
+  EXPECT_EQ(modelFromText(text, "m.json").minHeight, 27);
+  EXPECT_EQ(modelToText(modelFromText(text, "m.json")), text);
+  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": -3")).find("m.json: min_height: -3 out of range"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": 2.5")).find("min_height: expected an integer"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": \"27\"")).find("min_height: expected an integer"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": 99999999999")).find("min_height"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": null")).find("min_height"),
+            std::string::npos);
+}
+
 TEST(ModelIo, SaveAndLoadFile) {
   const auto dir = std::filesystem::temp_directory_path() / "fusedet_model_io_test";
   std::filesystem::create_directories(dir);
@@ -107,7 +131,9 @@ TEST(ModelIo, ErrorsNameThePlaceAndTheReason) {
 }
 
 TEST(ModelIo, FuzzedFilesNeverCrash) {
-  const std::string good = modelToText(sample());
+  Cascade withMin = sample();
+  withMin.minHeight = 31;  // the optional field is fuzzed too
+  const std::string good = modelToText(withMin);
   std::mt19937 rng(11);
   int loaded = 0, rejected = 0;
   for (int it = 0; it < 3000; ++it) {
