@@ -382,11 +382,13 @@ const bool registered = registerCommand(
       app.add_option("--validation-part", o->validationPart,
                      "hold back about 1/N of the training items (N >= 2; 0 = off) as a validation part that is "
                      "never trained on: whole groups (drives), smallest first, when the items come from several "
-                     "groups, else every N-th item. Each stage's threshold then keeps --min-hit of the held-back "
-                     "positives reaching it (instead of the training positives, whose sums are optimistic), and "
+                     "groups, else every N-th item. Each stage's threshold then keeps --validation-min-hit of the "
+                     "held-back positives reaching it (instead of --min-hit of the training positives, whose sums "
+                     "are optimistic), and "
                      "the stage count kept is the one with the best F on the held-back frames (detection with "
                      "--eval-scale-factor, --eval-step, --eval-min-neighbors; stage counts whose cascade accepts "
-                     "more than 1e-3 of the label-free windows are not tried). Not with mpirun")
+                     "more than 1e-3 of the label-free windows are not tried). Not with mpirun. Off by default: on "
+                     "3 drive-disjoint car folds it lost (boost/README.md)")
           ->check(CLI::Range(0, 1000))
           ->capture_default_str();
       app.add_option("--validation-min-hit", o->validationMinHit,
