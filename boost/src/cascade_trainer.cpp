@@ -158,7 +158,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   report.positives = stacks.positives().size();
   SampleConfig heldSamples = config.samples;
   heldSamples.jitterCopies = 0;  // the held-back positives as labelled (and mirrored)
-  const TrainingStacks held(heldItems, layers, refHue, heldSamples);
+  const TrainingStacks held(heldItems, layers, refHue, heldSamples, Shard{}, normalised);
   report.validationItems = heldItems.size();
   report.validationPositives = held.positives().size();
   if (stacks.positives().empty())
