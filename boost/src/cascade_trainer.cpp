@@ -211,6 +211,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   }
 
   NegativeMiner miner(stacks);
+  std::optional<PositiveFeatures> positiveValues;  // built at the first stage
   std::map<std::size_t, int> cascadeIndex;  // pool feature -> Cascade::features index
   std::size_t initialCandidates = 0;
   for (int stage = 1;; ++stage) {
@@ -261,7 +262,9 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     }
 
     // Positives the cascade still accepts.
-    std::vector<Sample> samples = acceptedPositives(stacks, cascade, job);
+    const std::vector<std::size_t> acceptedIndex = acceptedPositiveIndices(stacks, cascade, job);
+    std::vector<Sample> samples;
+    for (std::size_t k : acceptedIndex) samples.push_back(stacks.positives()[k]);
     const std::size_t positives = samples.size();
     if (positives < config.minPositives) {
       report.stopReason = "too few positives left: the cascade accepts " + std::to_string(positives) +
@@ -317,12 +320,26 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
           [&](std::span<const float> w, std::span<float> chosen) { return sharded.findStump(w, chosen, sc.refineTop); },
           sc, onRound);
     } else {
-      const SampleFeatures values(stacks, pool, samples);
+      // Positives' values from the training-wide cache when it fits, else evaluated each stage
+      // (same values either way).
+      if (!positiveValues && PositiveFeatures::bytes(pool.size(), stacks.positives().size()) <= config.positiveCacheBytes)
+        positiveValues.emplace(stacks, pool, config.threads);
+      std::optional<SampleFeatures> all;
+      std::optional<StageFeatures> staged;
+      if (positiveValues)
+        staged.emplace(*positiveValues, acceptedIndex, stacks, pool,
+                       std::span<const Sample>(samples).subspan(positives));
+      else
+        all.emplace(stacks, pool, samples);
       const FeatureMatrix matrix = buildFeatureMatrix(
           pool.size(), n,
-          [&](std::size_t first, std::size_t count, std::span<float> out) { values.block(first, count, out); },
+          [&](std::size_t first, std::size_t count, std::span<float> out) {
+            staged ? staged->block(first, count, out) : all->block(first, count, out);
+          },
           config.threads, 1024);
-      const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) { values.feature(f, out); };
+      const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) {
+        staged ? staged->feature(f, out) : all->feature(f, out);
+      };
       tb = Clock::now();
       matrixSeconds = std::chrono::duration<double>(tb - tm).count();
       matrixBytes = matrix.bytes();

@@ -14,7 +14,10 @@
 namespace fusedet::boosting {
 
 FeatureMatrix::FeatureMatrix(std::size_t features, std::size_t samples)
-    : bins_(features * samples), features_(features), samples_(samples) {}
+    : bins_(features * samples), quantileBin_(samples), features_(features), samples_(samples) {
+  // The quantile bin of each rank, once per matrix instead of a division per sample and feature.
+  for (std::size_t p = 0; p < samples; ++p) quantileBin_[p] = static_cast<std::uint8_t>(p * kMaxBins / samples);
+}
 
 std::vector<float> binEdges(std::span<const float> values) {
   // Evenly strided subsample: deterministic, and enough for 255 quantiles.
@@ -74,17 +77,24 @@ void FeatureMatrix::setFeature(std::size_t f, std::span<const float> values) {
   s.key2.resize(n);
   s.idx.resize(n);
   s.idx2.resize(n);
+  // Keys and the counts of all four bytes in one pass over the values.
+  std::array<std::array<std::uint32_t, 257>, 4> count{};
   for (std::size_t i = 0; i < n; ++i) {
-    s.key[i] = sortKey(values[i]);
+    const std::uint32_t k = sortKey(values[i]);
+    s.key[i] = k;
     s.idx[i] = static_cast<std::uint32_t>(i);
+    ++count[0][(k & 0xFFu) + 1];
+    ++count[1][((k >> 8) & 0xFFu) + 1];
+    ++count[2][((k >> 16) & 0xFFu) + 1];
+    ++count[3][(k >> 24) + 1];
   }
-  for (int shift = 0; shift < 32; shift += 8) {
-    std::array<std::uint32_t, 257> count{};
-    for (std::size_t i = 0; i < n; ++i) ++count[((s.key[i] >> shift) & 0xFFu) + 1];
-    if (std::any_of(count.begin() + 1, count.end(), [n](std::uint32_t c) { return c == n; })) continue;
-    for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+  for (int pass = 0; pass < 4; ++pass) {
+    std::array<std::uint32_t, 257>& c = count[static_cast<std::size_t>(pass)];
+    if (std::any_of(c.begin() + 1, c.end(), [n](std::uint32_t v) { return v == n; })) continue;
+    for (int b = 0; b < 256; ++b) c[b + 1] += c[b];
+    const int shift = 8 * pass;
     for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t pos = count[(s.key[i] >> shift) & 0xFFu]++;
+      const std::uint32_t pos = c[(s.key[i] >> shift) & 0xFFu]++;
       s.key2[pos] = s.key[i];
       s.idx2[pos] = s.idx[i];
     }
@@ -93,20 +103,15 @@ void FeatureMatrix::setFeature(std::size_t f, std::span<const float> values) {
   }
   // Bins along the sorted order: equal values share a bin, bins never decrease. With at most
   // kMaxBins distinct values each gets its own bin (nothing lost to quantisation); otherwise
-  // bins are equal-count quantiles of all values.
+  // bins are equal-count quantiles of all values (quantileBin_[p] = p * kMaxBins / n).
   std::size_t distinct = 1;
   for (std::size_t p = 1; p < n; ++p) distinct += s.key[p] != s.key[p - 1];
   std::uint8_t* out = bins_.data() + f * samples_;
+  const bool ownBins = distinct <= static_cast<std::size_t>(kMaxBins);
   unsigned bin = 0;
   out[s.idx[0]] = 0;
   for (std::size_t p = 1; p < n; ++p) {
-    if (s.key[p] != s.key[p - 1]) {
-      if (distinct <= static_cast<std::size_t>(kMaxBins)) {
-        ++bin;
-      } else {
-        bin = std::max(bin, static_cast<unsigned>(p * kMaxBins / n));
-      }
-    }
+    if (s.key[p] != s.key[p - 1]) bin = ownBins ? bin + 1 : std::max<unsigned>(bin, quantileBin_[p]);
     out[s.idx[p]] = static_cast<std::uint8_t>(bin);
   }
 }

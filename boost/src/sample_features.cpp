@@ -1,5 +1,9 @@
 #include "fusedet/boost/sample_features.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <numeric>
 #include <stdexcept>
@@ -40,7 +44,12 @@ SampleFeatures::SampleFeatures(const TrainingStacks& stacks, std::span<const Fea
 }
 
 void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float> out) const {
-  const std::size_t n = samples_.size();
+  block(first, count, out, samples_.size(), 0);
+}
+
+void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float> out, std::size_t rowStride,
+                           std::size_t column0) const {
+  float* const dst = out.data() + column0;
   std::vector<FeatureLayout> layouts(count);
   for (std::size_t r = 0; r + 1 < runStart_.size(); ++r) {
     // Layouts relative to the window origin, shared by the whole group (layoutFeature is
@@ -68,7 +77,7 @@ void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float
         const double last = rs(l.blackCount);
         const double white = l.whiteIsRest ? last - black : last;
         const double value = black / l.blackArea - white / l.whiteArea;
-        out[k * n + i] = static_cast<float>(li.contrastNormalised ? value / contrast_[i * layers_ + layer] : value);
+        dst[k * rowStride + i] = static_cast<float>(li.contrastNormalised ? value / contrast_[i * layers_ + layer] : value);
       }
     }
   }
@@ -77,6 +86,44 @@ void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float
 void SampleFeatures::feature(std::size_t f, std::span<float> out) const {
   for (std::size_t i = 0; i < samples_.size(); ++i)
     out[i] = featureValue(stacks_.integrals(samples_[i].stack), pool_[f], samples_[i].window);
+}
+
+PositiveFeatures::PositiveFeatures(const TrainingStacks& stacks, std::span<const Feature> pool, int threads)
+    : values_(pool.size() * stacks.positives().size()), positives_(stacks.positives().size()) {
+  const SampleFeatures values(stacks, pool, stacks.positives());
+  constexpr std::size_t kBlock = 1024;
+  const std::size_t blocks = (pool.size() + kBlock - 1) / kBlock;
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t b = r.begin(); b != r.end(); ++b) {
+        const std::size_t first = b * kBlock, count = std::min(kBlock, pool.size() - first);
+        values.block(first, count, std::span<float>(values_).subspan(first * positives_, count * positives_));
+      }
+    });
+  });
+}
+
+StageFeatures::StageFeatures(const PositiveFeatures& positives, std::span<const std::size_t> accepted,
+                             const TrainingStacks& stacks, std::span<const Feature> pool,
+                             std::span<const Sample> negatives)
+    : positives_(positives), accepted_(accepted), negatives_(negatives), negativeValues_(stacks, pool, negatives) {}
+
+void StageFeatures::block(std::size_t first, std::size_t count, std::span<float> out) const {
+  const std::size_t n = samples(), p = accepted_.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    const float* cached = positives_.feature(first + k);
+    float* row = out.data() + k * n;
+    for (std::size_t i = 0; i < p; ++i) row[i] = cached[accepted_[i]];
+  }
+  negativeValues_.block(first, count, out, n, p);
+}
+
+void StageFeatures::feature(std::size_t f, std::span<float> out) const {
+  const std::size_t p = accepted_.size();
+  const float* cached = positives_.feature(f);
+  for (std::size_t i = 0; i < p; ++i) out[i] = cached[accepted_[i]];
+  negativeValues_.feature(f, out.subspan(p));
 }
 
 }  // namespace fusedet::boosting

@@ -84,18 +84,26 @@ NegativeHarvest shardedHarvest(const TrainingStacks& stacks, const Cascade& casc
   return h;
 }
 
-std::vector<Sample> acceptedPositives(const TrainingStacks& stacks, const Cascade& cascade, Collective* job) {
+std::vector<std::size_t> acceptedPositiveIndices(const TrainingStacks& stacks, const Cascade& cascade,
+                                                 Collective* job) {
   const std::vector<Sample>& all = stacks.positives();
-  if (cascade.stages.empty()) return all;
-  std::vector<std::int64_t> accepted(all.size(), 0);
-  for (std::size_t k = 0; k < all.size(); ++k) {
-    if (job && stacks.owner(all[k].stack) != job->rank()) continue;
-    accepted[k] = evaluateWindow(cascade, stacks.integrals(all[k].stack), all[k].window).accepted ? 1 : 0;
+  std::vector<std::int64_t> accepted(all.size(), cascade.stages.empty() ? 1 : 0);
+  if (!cascade.stages.empty()) {
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      if (job && stacks.owner(all[k].stack) != job->rank()) continue;
+      accepted[k] = evaluateWindow(cascade, stacks.integrals(all[k].stack), all[k].window).accepted ? 1 : 0;
+    }
+    if (job) job->allReduceSum(accepted);
   }
-  if (job) job->allReduceSum(accepted);
-  std::vector<Sample> out;
+  std::vector<std::size_t> out;
   for (std::size_t k = 0; k < all.size(); ++k)
-    if (accepted[k]) out.push_back(all[k]);
+    if (accepted[k]) out.push_back(k);
+  return out;
+}
+
+std::vector<Sample> acceptedPositives(const TrainingStacks& stacks, const Cascade& cascade, Collective* job) {
+  std::vector<Sample> out;
+  for (std::size_t k : acceptedPositiveIndices(stacks, cascade, job)) out.push_back(stacks.positives()[k]);
   return out;
 }
 

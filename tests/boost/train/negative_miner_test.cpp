@@ -3,7 +3,8 @@
 // by Detector::scan(IntegralStack)), on real KITTI stacks fused from ../shared/data: the same
 // negatives (stack, box, order), candidate and window counts, stage by stage, for 1 and 2 threads,
 // also when the cascade given is not an extension of the previous one; and a cascade trained on
-// real data with both paths is the same model, byte for byte.
+// real data with both paths (and with the positives' feature values cached or evaluated every
+// stage) is the same model, byte for byte.
 
 #include "fusedet/boost/negative_miner.h"
 
@@ -83,13 +84,17 @@ void expectSameHarvest(const NegativeHarvest& got, const NegativeHarvest& want, 
   }
 }
 
-// `config` trained with the full rescan (first) and with the incremental miner (second).
+// `config` trained the old way (full rescan, positives' features evaluated every stage: first)
+// and with the incremental miner and the positives' feature cache (second).
 std::pair<Cascade, Cascade> trainBothWays(TrainingConfig config, TrainingReport& rescanReport,
                                           TrainingReport& minerReport) {
   NullProgress quiet;
+  const std::size_t cacheBytes = config.positiveCacheBytes;
   config.incrementalMining = false;
+  config.positiveCacheBytes = 0;
   Cascade rescan = trainCascade(config, kittiItems(), quiet, &rescanReport);
   config.incrementalMining = true;
+  config.positiveCacheBytes = cacheBytes;
   return {std::move(rescan), trainCascade(config, kittiItems(), quiet, &minerReport)};
 }
 

@@ -53,6 +53,10 @@ struct TrainingConfig {
   // Store the smallest training positive's height as the model's minimum detection height
   // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
   bool minHeightFromPositives = false;
+  // The pool's values on every positive are evaluated once per training and kept (pool x
+  // positives floats, sample_features.h) when they take at most this many bytes; above that
+  // they are evaluated again each stage. Same values either way.
+  std::size_t positiveCacheBytes = std::size_t(1) << 30;
 
   // Throws std::invalid_argument naming the bad setting.
   void validate() const;

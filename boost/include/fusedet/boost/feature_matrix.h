@@ -38,6 +38,7 @@ class FeatureMatrix {
 
  private:
   std::vector<std::uint8_t> bins_;  // features_ x samples_
+  std::vector<std::uint8_t> quantileBin_;  // per rank p: p * kMaxBins / samples_
   std::size_t features_ = 0, samples_ = 0;
 };
 

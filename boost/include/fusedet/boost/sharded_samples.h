@@ -25,7 +25,10 @@ double shardedReferenceHue(const std::vector<DatasetItem>& items, const SampleCo
 NegativeHarvest shardedHarvest(const TrainingStacks& stacks, const Cascade& cascade, std::size_t wanted,
                                std::uint64_t seed, int threads, Collective& job);
 
-// The positives `cascade` accepts, in positives() order (each rank evaluates its own).
+// The positives `cascade` accepts, in positives() order (each rank evaluates its own), and their
+// indices into positives().
 std::vector<Sample> acceptedPositives(const TrainingStacks& stacks, const Cascade& cascade, Collective* job);
+std::vector<std::size_t> acceptedPositiveIndices(const TrainingStacks& stacks, const Cascade& cascade,
+                                                 Collective* job);
 
 }  // namespace fusedet::boosting
