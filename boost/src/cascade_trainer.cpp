@@ -154,7 +154,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   report.referenceHue = refHue;
 
   const std::vector<bool> normalised = config.pool.contrastFlags();
-  const TrainingStacks stacks(train, layers, refHue, config.samples, shard, normalised);
+  const TrainingStacks stacks(train, layers, refHue, config.samples, shard, normalised, config.threads);
   report.positives = stacks.positives().size();
   SampleConfig heldSamples = config.samples;
   heldSamples.jitterCopies = 0;  // the held-back positives as labelled (and mirrored)

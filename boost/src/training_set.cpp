@@ -1,6 +1,9 @@
 #include "fusedet/boost/training_set.h"
 
 #include <opencv2/core.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <random>
@@ -57,6 +60,12 @@ std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double 
   return out;
 }
 
+Labels flippedLabels(const DatasetItem& item) {
+  Labels out = item.labels;
+  for (Label& l : out) l.box.x = item.stack.width() - l.box.x - l.box.w;
+  return out;
+}
+
 DatasetItem flipItem(const DatasetItem& item) {
   DatasetItem out;
   out.id = item.id + "#flipped";
@@ -72,43 +81,63 @@ DatasetItem flipItem(const DatasetItem& item) {
     if (l.hasMask()) cv::flip(l.valid, m.valid, 1);
     out.stack.set(std::move(m));
   }
-  out.labels = item.labels;
-  for (Label& l : out.labels) l.box.x = item.stack.width() - l.box.x - l.box.w;
+  out.labels = flippedLabels(item);
   return out;
 }
 
 TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                const std::vector<std::string>& layers,
                                std::optional<double> referenceHue, const SampleConfig& config, Shard shard,
-                               const std::vector<bool>& contrastNormalised)
+                               const std::vector<bool>& contrastNormalised, int threads)
     : config_(config), shard_(shard) {
-  std::mt19937_64 rng(config_.jitterSeed);
-  auto addStack = [&](const DatasetItem& item, std::size_t itemIndex) {
-    const auto index = static_cast<std::uint32_t>(integrals_.size());
-    const bool mine = shard_.owns(itemIndex);
-    try {
-      integrals_.push_back(mine ? IntegralStack(item.stack, layers, referenceHue, false, contrastNormalised)
-                                : IntegralStack());
-    } catch (const std::exception& e) {
-      throw std::runtime_error("training item " + item.id + ": " + e.what());
-    }
-    owner_.push_back(static_cast<int>(itemIndex % static_cast<std::size_t>(shard_.ranks)));
-    labels_.push_back(item.labels);
-    for (const Label& l : item.labels)
-      if (isPositiveLabel(l, config_)) {
-        positives_.push_back(Sample{index, l.box});
-        // Windows reaching over the border are clamped into the layer, as the labels' own are.
-        for (const Box& b : jitteredBoxes(l.box, config_.jitterCopies, config_.jitterShift, config_.jitterScale, rng))
-          positives_.push_back(Sample{index, b});
-      }
-  };
-  for (std::size_t i = 0; i < items.size(); ++i) addStack(items[i], i);
-  originals_ = integrals_.size();
+  // Stacks: the items, then mirrored copies of the items holding positives. Labels, owners and
+  // positives (with the jitter draws) in that order, serially; the integrals in parallel.
+  std::vector<std::pair<std::size_t, bool>> source;  // item index, mirrored
+  for (std::size_t i = 0; i < items.size(); ++i) source.emplace_back(i, false);
+  originals_ = items.size();
   if (config_.flipPositives)
     for (std::size_t i = 0; i < items.size(); ++i)
       if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
                       [&](const Label& l) { return isPositiveLabel(l, config_); }))
-        addStack(flipItem(items[i]), i);
+        source.emplace_back(i, true);
+  std::mt19937_64 rng(config_.jitterSeed);
+  for (std::size_t k = 0; k < source.size(); ++k) {
+    const auto [i, mirrored] = source[k];
+    owner_.push_back(static_cast<int>(i % static_cast<std::size_t>(shard_.ranks)));
+    Labels labels = items[i].labels;
+    if (mirrored) labels = flippedLabels(items[i]);
+    for (const Label& l : labels)
+      if (isPositiveLabel(l, config_)) {
+        positives_.push_back(Sample{static_cast<std::uint32_t>(k), l.box});
+        // Windows reaching over the border are clamped into the layer, as the labels' own are.
+        for (const Box& b : jitteredBoxes(l.box, config_.jitterCopies, config_.jitterShift, config_.jitterScale, rng))
+          positives_.push_back(Sample{static_cast<std::uint32_t>(k), b});
+      }
+    labels_.push_back(std::move(labels));
+  }
+  integrals_.resize(source.size());
+  auto integrate = [&](std::size_t k) {
+    const auto [i, mirrored] = source[k];
+    if (!shard_.owns(i)) return;
+    try {
+      integrals_[k] = mirrored ? IntegralStack(flipItem(items[i]).stack, layers, referenceHue, false, contrastNormalised)
+                               : IntegralStack(items[i].stack, layers, referenceHue, false, contrastNormalised);
+    } catch (const std::exception& e) {
+      throw std::runtime_error("training item " + (mirrored ? items[i].id + "#flipped" : items[i].id) + ": " +
+                               e.what());
+    }
+  };
+  if (threads == 1) {
+    for (std::size_t k = 0; k < source.size(); ++k) integrate(k);
+  } else {
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source.size(), 1),
+                        [&](const tbb::blocked_range<std::size_t>& r) {
+                          for (std::size_t k = r.begin(); k != r.end(); ++k) integrate(k);
+                        });
+    });
+  }
 }
 
 double TrainingStacks::positiveAspect() const {

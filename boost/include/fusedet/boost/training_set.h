@@ -98,9 +98,10 @@ class TrainingStacks {
   // With a shard, only the items this rank owns (and their mirrored copies) are integrated; the
   // others need only labels and reference size (readDatasetItemLabels()). contrastNormalised
   // (empty or one flag per layer): those layers' features are contrast-normalised (feature.h).
+  // threads (1 = the calling thread, 0 = all cores) share the integrals; the result is the same.
   TrainingStacks(const std::vector<DatasetItem>& items, const std::vector<std::string>& layers,
                  std::optional<double> referenceHue, const SampleConfig& config, Shard shard = {},
-                 const std::vector<bool>& contrastNormalised = {});
+                 const std::vector<bool>& contrastNormalised = {}, int threads = 1);
 
   std::size_t size() const { return integrals_.size(); }
   const IntegralStack& integrals(std::size_t i) const { return integrals_.at(i); }
@@ -142,5 +143,7 @@ std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double 
 
 // Horizontally mirrored copy of a stack (every layer and mask) and its labels.
 DatasetItem flipItem(const DatasetItem& item);
+// The labels of flipItem(item) alone.
+Labels flippedLabels(const DatasetItem& item);
 
 }  // namespace fusedet::boosting
