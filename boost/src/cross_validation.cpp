@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "fusedet/boost/model_io.h"
@@ -68,7 +69,8 @@ std::string trainingKey(const TrainingConfig& config, const std::vector<std::str
 
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
-                    ProgressSink& progress, TrainingReport* report, bool* fromCache) {
+                    ProgressSink& progress, TrainingReport* report, bool* fromCache,
+                    double* cachedTrainSeconds) {
   std::vector<DatasetItem> subset;
   std::vector<std::string> ids;
   subset.reserve(train.size());
@@ -80,7 +82,13 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
   const std::filesystem::path file = cacheDir.empty() ? std::filesystem::path() : cacheDir / (key + ".json");
   if (!file.empty() && std::filesystem::exists(file)) {
     if (fromCache) *fromCache = true;
-    return loadModel(file);
+    Cascade cached = loadModel(file);
+    if (cachedTrainSeconds) {
+      *cachedTrainSeconds = 0;
+      for (const auto& [k, v] : loadModelInfo(file))
+        if (k == "train_seconds") *cachedTrainSeconds = std::strtod(v.c_str(), nullptr);
+    }
+    return cached;
   }
   if (fromCache) *fromCache = false;
   TrainingReport local;
@@ -118,11 +126,13 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     try {
       for (const TrainingConfig& part : spec.parts) {
         bool cached = false;
+        double recorded = 0;
         TrainingReport report;
         const auto t0 = std::chrono::steady_clock::now();
-        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached);
+        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached, &recorded);
         out.trainSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out.cachedFolds += cached ? 1 : 0;
+        out.cachedTrainSeconds += cached ? recorded : 0;
         parts.push_back(summarizeCascade(c));
         detectors.emplace_back(std::move(c));
       }

@@ -251,13 +251,31 @@ void saveModel(const Cascade& cascade, const std::filesystem::path& file, const 
   if (!out) throw ModelError(file.string() + ": write failed");
 }
 
-Cascade loadModel(const std::filesystem::path& file) {
+namespace {
+std::string readModelText(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);
   if (!in) throw ModelError(file.string() + ": cannot open (" +
                             (std::filesystem::exists(file) ? "not readable" : "no such file") + ")");
   std::ostringstream s;
   s << in.rdbuf();
-  return modelFromText(s.str(), file.string());
+  return s.str();
+}
+}  // namespace
+
+Cascade loadModel(const std::filesystem::path& file) { return modelFromText(readModelText(file), file.string()); }
+
+ModelInfo loadModelInfo(const std::filesystem::path& file) {
+  const std::string text = readModelText(file);
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::exception& e) {
+    throw ModelError(file.string() + ": not valid JSON (" + e.what() + ")");
+  }
+  ModelInfo info;
+  if (!root.is_object() || !root.contains("training") || !root["training"].is_object()) return info;
+  for (const auto& [k, v] : root["training"].items()) info.emplace_back(k, v.is_string() ? v.get<std::string>() : v.dump());
+  return info;
 }
 
 }  // namespace fusedet::boosting

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <string>
+#include <unistd.h>
 
 using namespace fusedet;
 using namespace fusedet::boosting;
@@ -102,6 +104,27 @@ TEST(ModelIo, SaveAndLoadFile) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("missing.json: cannot open (no such file)"), std::string::npos) << e.what();
   }
+}
+
+// The "training" pairs come back as written (the fold-model cache reads "train_seconds" from them);
+// a model without them has none; a file that is not JSON is a clear error.
+TEST(ModelIo, TrainingInfoIsReadBack) {
+  const auto dir = std::filesystem::temp_directory_path() / ("fusedet_model_info_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const ModelInfo info = {{"train_seconds", "12.5"}, {"stop_reason", "stage limit 4 reached"}};
+  saveModel(sample(), dir / "with.json", info);
+  EXPECT_EQ(loadModelInfo(dir / "with.json"), info);
+  saveModel(sample(), dir / "without.json");
+  EXPECT_TRUE(loadModelInfo(dir / "without.json").empty());
+  std::ofstream(dir / "garbage.json") << "{\"training\": {\"train_seconds\": 3";
+  try {
+    loadModelInfo(dir / "garbage.json");
+    FAIL() << "no exception";
+  } catch (const ModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("garbage.json: not valid JSON"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(loadModelInfo(dir / "missing.json"), ModelError);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ModelIo, ErrorsNameThePlaceAndTheReason) {

@@ -30,11 +30,14 @@ std::string describeTrainingConfig(const TrainingConfig& config);
 std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds);
 
 // Trains on items[train] (or loads `cacheDir/<key>.json` when it exists; empty cacheDir = no
-// cache) and writes the model there. `fromCache` tells which. Throws what trainCascade throws
-// (e.g. too few positives).
+// cache) and writes the model there. `fromCache` tells which; for a cached model
+// `cachedTrainSeconds` gets the training time its file records (0 if none), so a run from the
+// cache can still say what it would cost without one. Throws what trainCascade throws (e.g. too
+// few positives).
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
-                    ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr);
+                    ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr,
+                    double* cachedTrainSeconds = nullptr);
 
 // Outcome of one configuration over all folds.
 struct CrossValidationResult {
@@ -45,6 +48,7 @@ struct CrossValidationResult {
   std::vector<CascadeSummary> summaries;            // per trained fold
   double trainSeconds = 0, msPerStack = 0;          // summed training; mean detection time
   std::size_t cachedFolds = 0;
+  double cachedTrainSeconds = 0;  // training time the cached folds' model files record, summed
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.

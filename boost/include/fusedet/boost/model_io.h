@@ -56,5 +56,8 @@ Cascade modelFromText(const std::string& text, const std::string& source);
 void saveModel(const Cascade& cascade, const std::filesystem::path& file, const ModelInfo& info = {});
 // Throws ModelError naming the file, the place and the reason. Cascade::source = file.
 Cascade loadModel(const std::filesystem::path& file);
+// The informative "training" pairs of a model file (empty when it has none; values that are not
+// strings as JSON text). Throws ModelError for an unreadable file or text that is not JSON.
+ModelInfo loadModelInfo(const std::filesystem::path& file);
 
 }  // namespace fusedet::boosting
