@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -28,6 +29,7 @@
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/cross_validation.h"
 #include "fusedet/boost/data_split.h"
+#include "fusedet/boost/experiment_plan.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/fusion/kitti_drives.h"
 #include "fusedet/fusion/kitti_import.h"
@@ -45,19 +47,21 @@ struct ExperimentOptions {
   fs::path datasetCache;  // default OUT/dataset
   fs::path modelCache;    // default OUT/fold-models
   fs::path modelsOut;     // optional: the all-layers model per class trained on every frame
-  bool quick = false;
+  std::string preset = "bundled";  // boosting::experimentPlan(); the fields below override it
   std::vector<std::string> classes = {"car", "person", "bike"};
-  std::vector<std::string> configs = {"all", "no_corners", "laser", "camera", "four", "and"};
+  std::vector<std::string> configs;        // empty = the preset's
+  std::vector<std::string> configClasses;  // empty = the preset's
   std::string van = "ignore";
-  int folds = -1;  // -1 = preset (every drive; quick 3), 0 = every drive
+  int folds = -1;         // -1 = the preset's, 0 = every drive
+  int learningFolds = -1;  // -1 = the preset's
   std::vector<std::string> learning;  // training drives per fold for the learning curve
   bool learningSet = false;
   std::size_t resamples = 0;
   std::uint64_t seed = 1;
   int threads = 0;
   bool peers = true;
-  double peerUpscale = 0;  // 0 = 2, or 1 with --quick
-  // Training; 0 = the preset of --quick or the full run.
+  double peerUpscale = 0;  // 0 = the preset's
+  // Training; 0 = the preset's.
   int grid = 0, maxStages = 0, maxWeak = 0;
   double targetFalseAlarm = 0;
   std::optional<std::size_t> negatives;  // 0 = the trainer's rule, max(500, 2 x positives)
@@ -101,8 +105,8 @@ const TrainedConfig& trainedConfig(const std::string& name) {
     if (t.name == name) return t;
   throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and, channels)");
 }
-bool wantsChannels(const ExperimentOptions& o) {
-  return std::find(o.configs.begin(), o.configs.end(), "channels") != o.configs.end();
+bool wantsChannels(const std::vector<std::string>& configs) {
+  return std::find(configs.begin(), configs.end(), "channels") != configs.end();
 }
 
 std::string shortNum(double v) {
@@ -115,6 +119,30 @@ std::string joined(const std::vector<std::string>& v, const std::string& sep = "
   std::string s;
   for (const auto& x : v) s += (s.empty() ? "" : sep) + x;
   return s;
+}
+
+std::string foldsText(std::size_t folds, std::size_t drives) {
+  return folds == drives ? "leave-one-drive-out (" + std::to_string(folds) + " folds)"
+                         : std::to_string(folds) + " drive-disjoint folds";
+}
+
+// " (bundled: 8, quick: 6)": every preset's value of a field (boost/experiment_plan.h), for --help.
+std::string presets(const std::function<std::string(const boosting::ExperimentPlan&)>& field) {
+  std::string s;
+  for (const std::string& n : boosting::experimentPlanNames())
+    s += (s.empty() ? " (" : ", ") + n + ": " + field(boosting::experimentPlan(n));
+  return s + ")";
+}
+template <typename T>
+std::string presets(T boosting::ExperimentPlan::*field) {
+  return presets([field](const boosting::ExperimentPlan& p) { return shortNum(static_cast<double>(p.*field)); });
+}
+
+std::string learningText(const std::vector<std::size_t>& drives) {
+  if (drives.empty()) return "none";
+  std::vector<std::string> v;
+  for (std::size_t k : drives) v.push_back(k == 0 ? "all" : std::to_string(k));
+  return joined(v);
 }
 
 // Drive directories under a KITTI root: the three shared ones first (in the documented order),
@@ -141,7 +169,7 @@ std::vector<fs::path> kittiDrives(const fs::path& root) {
 
 // The data set to use: --data itself when it is one, else the KITTI drives under it imported
 // once into the cache directory (a marker file records a finished import of the same drives).
-fs::path resolveDataset(const ExperimentOptions& o) {
+fs::path resolveDataset(const ExperimentOptions& o, bool channels) {
   if (fs::exists(o.data / "dataset.json")) {
     std::printf("data set: %s\n", o.data.c_str());
     return o.data;
@@ -155,7 +183,7 @@ fs::path resolveDataset(const ExperimentOptions& o) {
   std::string signature;
   for (const auto& d : drives) signature += fs::absolute(d).lexically_normal().string() + "\n";
   fusion::KittiImportOptions import;
-  import.projection.extraChannels = wantsChannels(o);
+  import.projection.extraChannels = channels;
   if (import.projection.extraChannels) signature += "with channels\n";
   const fs::path marker = cache / "imported-from.txt";
   if (std::ifstream in(marker); in) {
@@ -193,25 +221,9 @@ std::vector<std::string> drivesOf(const ExperimentOptions& o, const std::vector<
   return drives;
 }
 
-struct Preset {
-  int grid, maxStages, maxWeak;
-  double targetFalseAlarm;
-  std::size_t negatives;
-  double trainScaleFactor, trainStep;
-  double scaleFactor, step;
-  int folds;
-  std::size_t resamples;
-  int validationPart;  // 0 = off (boost/validation_part.h)
-};
-
-Preset presetFor(const ExperimentOptions& o) {
-  // Quick: a coarse pool, a few small stages, 3 drive-disjoint folds: the whole pipeline in a few
-  // minutes, for the ctest smoke run. Full: every drive is a fold (leave-one-drive-out). Its
-  // training is much lighter than the old within-drive run's (grid 12, 20 stages x 100 stumps,
-  // 18.5 min for 15 cascades): here 22 folds x 5 configurations x 3 classes plus the learning
-  // curve are ~460 cascades, which must fit about an hour on 2 cores shared with other jobs.
-  Preset p = o.quick ? Preset{6, 4, 5, 1e-3, 200, 1.5, 6, 1.3, 4, 3, 200, 0}
-                     : Preset{6, 8, 15, 1e-4, 300, 1.25, 3, 1.2, 3, 0, 1000, 0};
+// The preset (boost/experiment_plan.h) with the options given on the command line.
+boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
+  boosting::ExperimentPlan p = boosting::experimentPlan(o.preset);
   if (o.grid > 0) p.grid = o.grid;
   if (o.maxStages > 0) p.maxStages = o.maxStages;
   if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
@@ -222,12 +234,30 @@ Preset presetFor(const ExperimentOptions& o) {
   if (o.scaleFactor > 0) p.scaleFactor = o.scaleFactor;
   if (o.step > 0) p.step = o.step;
   if (o.folds >= 0) p.folds = o.folds;
+  if (o.learningFolds >= 0) p.learningFolds = o.learningFolds;
   if (o.resamples > 0) p.resamples = o.resamples;
   if (o.validationPart >= 0) p.validationPart = o.validationPart;
+  if (o.peerUpscale > 0) p.peerUpscale = o.peerUpscale;
+  if (!o.configs.empty()) p.configs = o.configs;
+  if (!o.configClasses.empty()) p.configClasses = o.configClasses;
+  if (o.learningSet) {
+    p.learningDrives.clear();
+    for (const std::string& v : o.learning) {
+      if (v == "none") continue;
+      if (v == "all") {
+        p.learningDrives.push_back(0);
+        continue;
+      }
+      std::size_t used = 0;
+      const unsigned long n = std::stoul(v, &used);
+      if (used != v.size() || n == 0) throw std::runtime_error("--learning: '" + v + "' is not a drive count >= 1, all or none");
+      p.learningDrives.push_back(n);
+    }
+  }
   return p;
 }
 
-boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const Preset& p, const std::string& cls,
+boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosting::ExperimentPlan& p, const std::string& cls,
                                         const TrainedConfig& tc, const boosting::MatchConfig& match) {
   boosting::TrainingConfig c;
   c.className = cls;
@@ -260,7 +290,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const Preset
   return c;
 }
 
-boosting::ChainSpec chainFor(const ExperimentOptions& o, const Preset& p, const std::string& cls,
+boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::ExperimentPlan& p, const std::string& cls,
                              const std::string& config, const boosting::MatchConfig& match) {
   boosting::ChainSpec spec;
   if (config == "and") {
@@ -359,8 +389,9 @@ int runExperiments(ExperimentOptions o) {
   if (o.out.empty()) throw std::runtime_error("--out is required");
   fs::create_directories(o.out);
   const boosting::VanPolicy van = boosting::parseVanPolicy(o.van);
-  const Preset preset = presetFor(o);
-  for (const std::string& c : o.configs)
+  const boosting::ExperimentPlan preset = planFor(o);
+  const std::vector<std::string>& configs = preset.configs;
+  for (const std::string& c : configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
   {  // a layer no configuration has is a typo
     std::vector<std::string> known;
@@ -372,10 +403,14 @@ int runExperiments(ExperimentOptions o) {
   boot.resamples = preset.resamples;
   boot.seed = o.seed;
 
-  const fs::path dataset = resolveDataset(o);
+  const fs::path dataset = resolveDataset(o, wantsChannels(configs));
   const std::vector<DatasetEntry> manifest = readDatasetManifest(dataset);
   const std::vector<std::string> driveOf = drivesOf(o, manifest);
   const std::vector<boosting::Fold> folds = boosting::crossGroupFolds(driveOf, static_cast<std::size_t>(preset.folds));
+  // The learning curve's folds: the same as the others' unless the preset deals fewer.
+  const bool learningOnSameFolds = preset.learningFolds == preset.folds;
+  const std::vector<boosting::Fold> learningFolds =
+      learningOnSameFolds ? folds : boosting::crossGroupFolds(driveOf, static_cast<std::size_t>(preset.learningFolds));
   const std::size_t driveCount = std::set<std::string>(driveOf.begin(), driveOf.end()).size();
 
   ExperimentReport report;
@@ -416,7 +451,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  const std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(o), driveOf);
+  const std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(configs), driveOf);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -424,9 +459,13 @@ int runExperiments(ExperimentOptions o) {
   setup.group.minNeighbors = o.minNeighbors;
 
   report.settings = {
-      {"preset", o.quick ? "quick" : "full"},
-      {"folds", folds.size() == driveCount ? "leave-one-drive-out (" + std::to_string(folds.size()) + ")"
-                                           : std::to_string(folds.size()) + " drive-disjoint"},
+      {"preset", preset.name},
+      {"configurations (`all`: every class)",
+       joined(configs) + (preset.configClasses.empty() ? std::string()
+                                                       : "; other than `all` for " + joined(preset.configClasses) + " only")},
+      {"learning curve (training drives per fold)",
+       learningText(preset.learningDrives) + " on " + foldsText(learningFolds.size(), driveCount)},
+      {"folds", foldsText(folds.size(), driveCount)},
       {"pool grid (units per side)", std::to_string(preset.grid)},
       {"max stages", std::to_string(preset.maxStages)},
       {"max stumps per stage", std::to_string(preset.maxWeak)},
@@ -462,7 +501,7 @@ int runExperiments(ExperimentOptions o) {
 
   // Peer (person only): OpenCV's HOG people detector on every frame (it is not trained here).
   if (o.peers && std::find(o.classes.begin(), o.classes.end(), "person") != o.classes.end()) {
-    const double upscale = o.peerUpscale > 0 ? o.peerUpscale : (o.quick ? 1.0 : 2.0);
+    const double upscale = preset.peerUpscale;
     const std::unique_ptr<PersonPeer> peer = makeHogPeer(upscale);
     const boosting::MatchConfig m = boosting::matchConfigFor("person", van);
     ConfigResult r;
@@ -490,15 +529,11 @@ int runExperiments(ExperimentOptions o) {
     framesOf["person"][r.config] = std::move(frames);
   }
 
-  std::vector<std::size_t> learning;
-  if (o.learningSet) {
-    for (const std::string& s : o.learning)
-      if (s != "none") learning.push_back(s == "all" ? driveCount : static_cast<std::size_t>(std::stoul(s)));
-  } else if (!o.quick) {
-    learning = {2, 6, driveCount};  // driveCount = all training drives: the main result
-  }
-  std::size_t mostDrives = 0;  // training drives of the largest fold
-  for (const auto& f : folds) mostDrives = std::max(mostDrives, boosting::trainingGroupCount(f, driveOf));
+  std::size_t mostDrives = 0;  // training drives of the largest learning-curve fold
+  for (const auto& f : learningFolds) mostDrives = std::max(mostDrives, boosting::trainingGroupCount(f, driveOf));
+  std::vector<std::size_t> learning;  // 0 ("all") = every training drive of the fold
+  for (std::size_t k : preset.learningDrives) learning.push_back(k == 0 ? mostDrives : std::min(k, mostDrives));
+  report.learningFolds = foldsText(learningFolds.size(), driveCount);
 
   std::map<std::string, std::vector<DatasetItem>> trainItemsOf;  // layers are shared, only labels differ
   for (const std::string& cls : o.classes) {
@@ -591,6 +626,9 @@ int runExperiments(ExperimentOptions o) {
     r.curve = boosting::precisionRecallCurve(boosting::allFrames(cv.frames));
     r.msPerStack = cv.msPerStack;
     r.trainSeconds = cv.trainSeconds;
+    r.cachedTrainSeconds = cv.cachedTrainSeconds;
+    report.trainSeconds += cv.trainSeconds;
+    report.cachedTrainSeconds += cv.cachedTrainSeconds;
     r.folds = folds.size();
     r.cachedFolds = cv.cachedFolds;
     r.failures = cv.failures;
@@ -604,9 +642,9 @@ int runExperiments(ExperimentOptions o) {
     printLine(r);
     // Keep the table order of --configs whatever order the phases ran in.
     const auto rank = [&](const ConfigResult& x) {
-      const auto it = std::find(o.configs.begin(), o.configs.end(), x.config);
+      const auto it = std::find(configs.begin(), configs.end(), x.config);
       return std::make_pair(std::find(o.classes.begin(), o.classes.end(), x.className) - o.classes.begin(),
-                            x.trained ? it - o.configs.begin() : -1);
+                            x.trained ? it - configs.begin() : -1);
     };
     report.results.push_back(r);
     std::stable_sort(report.results.begin(), report.results.end(),
@@ -619,15 +657,16 @@ int runExperiments(ExperimentOptions o) {
 
   // Phase 1, the headline: the joint pool of every class. Phase 2: the paper's other
   // configurations (the claims). Phase 3: learning curves.
-  const bool wantAll = std::find(o.configs.begin(), o.configs.end(), "all") != o.configs.end();
+  const bool wantAll = std::find(configs.begin(), configs.end(), "all") != configs.end();
   if (wantAll)
     for (const std::string& cls : o.classes) {
       runConfig(cls, "all");
       writeSoFar(false);
     }
-  for (const std::string& config : o.configs) {
+  for (const std::string& config : configs) {
     if (config == "all") continue;
     for (const std::string& cls : o.classes) {
+      if (!boosting::runsFor(preset, config, cls)) continue;
       runConfig(cls, config);
       writeSoFar(false);
     }
@@ -639,15 +678,20 @@ int runExperiments(ExperimentOptions o) {
       for (std::size_t k : learning) {
         LearningPoint p;
         p.className = cls;
-        p.drives = std::min(k, mostDrives);
+        p.drives = k;
         std::vector<boosting::FrameOutcome> frames;
-        if (k >= mostDrives) {
+        if (k >= mostDrives && learningOnSameFolds) {
           frames = framesOf[cls]["all"];
         } else {
           std::vector<boosting::Fold> sub;
-          for (const auto& f : folds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
-          std::printf("%s / all, %zu training drives per fold:\n", cls.c_str(), k);
-          frames = boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log).frames;
+          for (const auto& f : learningFolds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
+          std::printf("%s / all, %zu training drives per fold (learning curve, %s):\n", cls.c_str(), k,
+                      report.learningFolds.c_str());
+          const boosting::CrossValidationResult cv =
+              boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log);
+          report.trainSeconds += cv.trainSeconds;
+          report.cachedTrainSeconds += cv.cachedTrainSeconds;
+          frames = cv.frames;
         }
         p.counts = boosting::countsOf(boosting::allFrames(frames));
         const Measured mm = measure(frames, boot);
@@ -711,59 +755,93 @@ const bool registered = registerCommand(
                      "OUT/fold-models); reused when present - use a fresh one after changing the trainer");
       app.add_option("--models-out", o->modelsOut,
                      "also train each class's all-layers cascade on every frame and write DIR/<class>.json");
-      app.add_flag("--quick", o->quick,
-                   "small pools (grid 6), at most 4 stages of 5 stumps, coarse scans, 3 drive-disjoint folds, 200 "
-                   "bootstrap resamples, no learning curve: the whole pipeline in a few minutes, for smoke tests; "
-                   "the numbers mean little");
+      app.add_option("--preset", o->preset,
+                     "what to run, each part overridable by the options below: bundled = the training of the "
+                     "bundled models (models/README.md) and the plan of docs/results: leave-one-drive-out for "
+                     "`all` of every class (the headline) and for the paper's configurations and `channels` "
+                     "(car), learning curves of `all` on 3 drive-disjoint folds; quick = the same plan scaled "
+                     "down to a smoke test (grid 6, at most 4 stages of 5 stumps, coarse scans, 3 folds, no "
+                     "`channels`; its numbers mean little)")
+          ->check(CLI::IsMember(boosting::experimentPlanNames()))
+          ->capture_default_str();
+      app.add_flag_callback("--quick", [o] { o->preset = "quick"; }, "the same as --preset quick");
       app.add_option("--classes", o->classes, "classes to run, in table order")->delimiter(',')->capture_default_str();
       app.add_option("--configs", o->configs,
                      "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
                      "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
                      "remission), and (laser AND camera; trains both), channels (beyond the paper: all seven "
                      "layers + grad_mag, grad_0..5, height, distance_grad, features a-j; the KITTI drives are "
-                     "then imported with `import-kitti --channels`; not in the default list)")
-          ->delimiter(',')
-          ->capture_default_str();
+                     "then imported with `import-kitti --channels`)" +
+                         presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
+          ->delimiter(',');
+      app.add_option("--config-classes", o->configClasses,
+                     "classes the configurations other than `all` run for (`all` runs for every class)" +
+                         presets([](const boosting::ExperimentPlan& p) {
+                           return p.configClasses.empty() ? std::string("every class") : joined(p.configClasses, ",");
+                         }))
+          ->delimiter(',');
       app.add_option("--van", o->van,
                      "what a KITTI Van is for car: ignore (the devkit's neighbouring class), negative (false "
                      "alarm), positive")
           ->check(CLI::IsMember({"ignore", "negative", "positive"}))
           ->capture_default_str();
       app.add_option("--folds", o->folds,
-                     "0 = leave-one-drive-out (every drive is a fold); k = drives dealt into k folds (default: 0, "
-                     "quick 3)");
+                     "folds of `all` and the configurations: 0 = leave-one-drive-out (every drive is a fold); k = "
+                     "drives sorted by name and dealt round-robin into k folds" +
+                         presets(&boosting::ExperimentPlan::folds));
+      app.add_option("--learning-folds", o->learningFolds,
+                     "folds of the learning curve, same meaning; when equal to --folds its `all` point is the "
+                     "headline's" +
+                         presets(&boosting::ExperimentPlan::learningFolds));
       app.add_option_function<std::vector<std::string>>(
              "--learning",
              [o](const std::vector<std::string>& v) {
                o->learning = v;
                o->learningSet = true;
              },
-             "training drives per fold for the learning curve of `all`, e.g. 1,2,4,8,all; none = no curve "
-             "(default: 2,6,all; quick: none)")
+             "training drives per fold for the learning curve of `all` (a seeded nested subset of each "
+             "fold's training drives), all = every one; none = no curve" +
+                 presets([](const boosting::ExperimentPlan& p) {
+                   std::vector<std::string> v;
+                   for (std::size_t k : p.learningDrives) v.push_back(k ? std::to_string(k) : "all");
+                   return v.empty() ? std::string("none") : joined(v, ",");
+                 }))
           ->delimiter(',');
-      app.add_option("--bootstrap", o->resamples, "bootstrap resamples of the frames (default: 1000, quick 200)");
+      app.add_option("--bootstrap", o->resamples,
+                     "bootstrap resamples of the frames" +
+                         presets(&boosting::ExperimentPlan::resamples));
       app.add_option("--seed", o->seed, "training and bootstrap seed (same seed + data = same numbers)")
           ->capture_default_str();
       app.add_option("--threads", o->threads, "training threads, 0 = all cores (detection is timed on one)")
           ->capture_default_str();
       app.add_flag("!--no-peers", o->peers, "skip OpenCV's HOG people detector");
       app.add_option("--peer-upscale", o->peerUpscale,
-                     "enlarge images by this factor for HOG, whose 64x128 window exceeds many KITTI pedestrians "
-                     "(default: 2, quick 1)")
+                     "enlarge images by this factor for HOG, whose 64x128 window exceeds many KITTI pedestrians" +
+                         presets(&boosting::ExperimentPlan::peerUpscale))
           ->check(CLI::Range(0.5, 4.0));
-      app.add_option("--grid", o->grid, "feature pool grid, units per side (default: 6)");
-      app.add_option("--max-stages", o->maxStages, "stage limit (default: 8, quick 4)");
-      app.add_option("--max-weak", o->maxWeak, "stumps per stage at most (default: 15, quick 5)");
-      app.add_option("--target-fa", o->targetFalseAlarm, "target false-alarm rate of the cascade (default: 1e-4, quick 1e-3)");
+      app.add_option("--grid", o->grid, "feature pool grid, units per side" +
+                                            presets(&boosting::ExperimentPlan::grid));
+      app.add_option("--max-stages", o->maxStages,
+                     "stage limit" + presets(&boosting::ExperimentPlan::maxStages));
+      app.add_option("--max-weak", o->maxWeak, "stumps per stage at most" + presets(&boosting::ExperimentPlan::maxWeak));
+      app.add_option("--target-fa", o->targetFalseAlarm,
+                     "target false-alarm rate of the cascade" +
+                         presets(&boosting::ExperimentPlan::targetFalseAlarm));
       app.add_option("--negatives", o->negatives,
-                     "negatives per stage; 0 = the trainer's rule, max(500, 2 x positives), as `fusedet train` "
-                     "(default: 300, quick 200)");
+                     "negatives per stage; 0 = the trainer's rule, max(500, 2 x positives), as `fusedet train`" +
+                         presets(&boosting::ExperimentPlan::negatives));
       app.add_option("--train-scale-factor", o->trainScaleFactor,
-                     "scale step of the training scan that bootstraps negatives (default: 1.25, quick 1.5)");
+                     "scale step of the training scan that bootstraps negatives" +
+                         presets(&boosting::ExperimentPlan::trainScaleFactor));
       app.add_option("--train-step", o->trainStep,
-                     "position step of that scan, in base-window pixels (default: 3, quick 6)");
-      app.add_option("--scale-factor", o->scaleFactor, "detection scale step on the test frames (default: 1.2, quick 1.3)");
-      app.add_option("--step", o->step, "detection position step in base-window pixels (default: 3, quick 4)");
+                     "position step of that scan, in base-window pixels" +
+                         presets(&boosting::ExperimentPlan::trainStep));
+      app.add_option("--scale-factor", o->scaleFactor,
+                     "detection scale step on the test frames" +
+                         presets(&boosting::ExperimentPlan::scaleFactor));
+      app.add_option("--step", o->step,
+                     "detection position step in base-window pixels" +
+                         presets(&boosting::ExperimentPlan::step));
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
       app.add_option("--contrast-normalise", o->contrastNormalise,
                      "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
@@ -792,16 +870,17 @@ const bool registered = registerCommand(
           "on cascades trained on all other drives, so no physical object is on both sides. Per class "
           "(car, person, bike) and configuration the folds' outcomes are pooled: F at the operating point "
           "and AP (KITTI, 40 recall points) with 95 % bootstrap intervals over frames; the paper's claims "
-          "(joint > laser-only, > camera-only, > AND; corners help) are judged with paired intervals of the "
-          "difference (a tie is \"not shown\"); a learning curve trains `all` on 1, 2, 4, ... drives per "
-          "fold. OpenCV's HOG people detector runs on every frame as the person peer. Evaluation: the KITTI "
+          "(joint > laser-only, > camera-only, > AND; corners help; beyond the paper: channels help) are "
+          "judged with the paired 95 % interval of the difference: \"holds\" only when it lies above 0, "
+          "\"contradicted\" when it lies below 0, \"not shown\" when it contains 0 (a tie); a learning curve "
+          "trains `all` on 1, 2, 4, ... drives per fold. OpenCV's HOG people detector runs on every frame as the person peer. Evaluation: the KITTI "
           "object devkit's 2D rules, moderate (see `fusedet eval --help`). A fold that cannot be trained "
           "(too few positives) counts as detecting nothing.\n"
           "Fold models are cached by a hash of the training settings and training item ids: a rerun with "
           "the same settings reuses them (delete the cache after changing the trainer's code).\n\n"
           "Examples:\n"
           "  fusedet experiments --out /tmp/exp --quick                 # smoke run, a few minutes\n"
-          "  nice -n 10 fusedet experiments --out /tmp/exp --threads 2  # the full run (long)\n"
+          "  nice -n 10 fusedet experiments --out /tmp/exp --threads 2  # docs/results in one run (hours)\n"
           "  fusedet experiments --out exp --classes car --configs all --learning none\n"
           "  fusedet experiments --data ds --out exp --folds 5 --van negative");
       return [o, &app] {

@@ -116,6 +116,10 @@ std::string renderMarkdown(const ExperimentReport& r) {
   md << "# " << r.title << "\n\n";
   md << "Produced by `" << r.command << "` in " << num(r.totalSeconds / 60.0, 1) << " min";
   if (r.loadAverage >= 0) md << " (load average " << num(r.loadAverage, 1) << " at the end, shared 2-core machine)";
+  md << "; fold cascades: " << num(r.trainSeconds / 60.0, 1) << " min of training in this run";
+  if (r.cachedTrainSeconds > 0)
+    md << ", and " << num(r.cachedTrainSeconds / 60.0, 1)
+       << " min recorded in the cached ones' model files (their training when they were made)";
   md << ". Cross-drive validation of the experiments of Klein, Schulz, Frintrop, \"Boosting with a Joint "
         "Feature Pool from Different Sensors\" (Tab. 2-7, Fig. 7): every fold tests on drives its cascades "
         "never saw. `results.json` holds the same numbers.\n\n";
@@ -167,7 +171,11 @@ std::string renderMarkdown(const ExperimentReport& r) {
                       std::to_string(c.counts.hits) + " / " + std::to_string(c.counts.falseAlarms) + " / " +
                           std::to_string(c.counts.misses),
                       c.trained ? num(c.meanLength, 0) : "-", num(c.msPerStack, 1),
-                      c.trained ? num(c.trainSeconds, 0) + (c.cachedFolds ? " (" + std::to_string(c.cachedFolds) + " cached)" : "") : "-",
+                      c.trained ? num(c.trainSeconds, 0) + (c.cachedFolds ? " (" + std::to_string(c.cachedFolds) +
+                                                                                " cached, " + num(c.cachedTrainSeconds, 0) +
+                                                                                " when made)"
+                                                                          : "")
+                                : "-",
                       c.failures.empty() ? "" : std::to_string(c.failures.size())});
     }
     if (body.empty()) continue;
@@ -216,7 +224,9 @@ std::string renderMarkdown(const ExperimentReport& r) {
           "Configuration `all` per class. Each fold keeps its held-out drive(s) and trains on a seeded "
           "random subset of the other drives (nested: a larger subset contains the smaller); pooled "
           "over folds. A curve still rising at the right end says more drives would help (data "
-          "limits); a flat one says the method does.\n\n";
+          "limits); a flat one says the method does.";
+    if (!r.learningFolds.empty()) md << " Folds: " << r.learningFolds << ".";
+    md << "\n\n";
     std::vector<std::vector<std::string>> body;
     for (const LearningPoint& p : r.learning)
       body.push_back({p.className, std::to_string(p.drives), formatEstimate(p.f), formatEstimate(p.ap),
@@ -294,6 +304,8 @@ json toJson(const ExperimentReport& r) {
   j["folds"] = r.folds;
   j["stacks"] = r.stacks;
   j["total_seconds"] = r.totalSeconds;
+  j["train_seconds"] = r.trainSeconds;
+  j["cached_train_seconds"] = r.cachedTrainSeconds;
   j["load_average"] = r.loadAverage;
   j["settings"] = r.settings;
   j["notes"] = r.notes;
@@ -331,6 +343,7 @@ json toJson(const ExperimentReport& r) {
       e["folds"] = c.folds;
       e["cached_folds"] = c.cachedFolds;
       e["train_seconds"] = c.trainSeconds;
+      e["cached_train_seconds"] = c.cachedTrainSeconds;
       e["layer_weight_share"] = c.layerWeightShare;
       e["source_weight_share"] = fusion::sharesBySource(c.layerWeightShare);
       e["corner_share"] = c.cornerShare;
@@ -342,6 +355,7 @@ json toJson(const ExperimentReport& r) {
     j["claims"].push_back({{"class", c.className}, {"key", c.key}, {"claim", c.text}, {"lhs", c.lhs}, {"rhs", c.rhs},
                            {"f_difference", estimateJson(c.fDifference)}, {"verdict", c.verdict},
                            {"ap_difference", estimateJson(c.apDifference)}, {"ap_verdict", c.apVerdict}});
+  j["learning_curve_folds"] = r.learningFolds;
   j["learning_curve"] = json::array();
   for (const LearningPoint& p : r.learning)
     j["learning_curve"].push_back({{"class", p.className}, {"drives", p.drives}, {"f_measure", estimateJson(p.f)},

@@ -38,7 +38,8 @@ struct ConfigResult {
   Estimate f, ap;                         // F at the operating point; AP (KITTI, 40 recall points)
   std::vector<boosting::PrPoint> curve;
   double msPerStack = 0;
-  double trainSeconds = 0;                          // summed over folds (0 for cached folds)
+  double trainSeconds = 0;                          // summed over folds (~0 for cached folds)
+  double cachedTrainSeconds = 0;                    // what the cached folds' model files record
   std::map<std::string, double> layerWeightShare;   // over all folds' cascades, sums to 1
   double cornerShare = 0;                           // share of weak classifiers that are corners
   std::size_t folds = 0, cachedFolds = 0;
@@ -84,10 +85,15 @@ struct ExperimentReport {
   std::vector<ConfigResult> results;
   std::vector<Claim> claims;
   std::vector<LearningPoint> learning;
+  std::string learningFolds;  // the learning curve's fold design, e.g. "3 drive-disjoint folds"
   std::vector<Goal> goals;
   std::map<std::string, std::string> settings;  // shown in a table and in results.json
   std::vector<std::string> notes;               // facts the run wants the reader to know
   double totalSeconds = 0;
+  // Training of every fold cascade the run used: done in this run, and recorded in the model
+  // files of the cached ones (their training when they were made) - together the run's cost
+  // without a cache.
+  double trainSeconds = 0, cachedTrainSeconds = 0;
   double loadAverage = -1;  // 1-minute load average at the end (shared machine), < 0 unknown
 };
 
