@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 namespace fusedet::fusion {
 namespace {
@@ -36,6 +37,14 @@ void SweepAssembler::addTilt(const drivers::TiltSample& sample) {
 void SweepAssembler::addScan(const drivers::LaserScan& scan) {
   ++stats_.scans;
   newestScan_ = std::max(newestScan_, lastBeamStamp(scan));
+  if (newestStart_) {
+    // Scans out of order or repeated make the gap <= 0, which turns closing on tilt off.
+    const std::int64_t gap = scan.stamp - *newestStart_;
+    minScanGapNs_ = minScanGapNs_ ? std::min(*minScanGapNs_, gap) : gap;
+  }
+  newestStart_ = scan.stamp;
+  newestSpanNs_ = lastBeamStamp(scan) - scan.stamp;
+  reversalRefuted_ = false;
   pending_.push_back(scan);
   process(false);
 }
@@ -73,11 +82,84 @@ void SweepAssembler::process(bool final) {
     else
       ++stats_.scansDroppedNoTilt;
     pending_.pop_front();
+    reversalRefuted_ = false;  // the next scan and the sweep's last tilt may have changed
   }
   // Keep the tilt history the pending scans (and late ones) can still need.
   const Stamp keepFrom = (pending_.empty() ? newestScan_ : pending_.front().stamp) - 2 * windowNs_;
   while (tilt_.size() > 2 && tilt_[1].stamp < keepFrom) tilt_.pop_front();
-  if (final) closeSweep();
+  if (final) {
+    closeSweep();
+  } else if (config_.closeOnTilt && tiltProvesReversal()) {
+    closeSweep();
+    ++stats_.sweepsClosedOnTilt;
+  }
+}
+
+// True when no scan still to come can join the open sweep. useScan() starts a new sweep with a
+// scan whose tilt moves against the direction by minTiltChange inside it, or - moving less than
+// that inside it - since the last used scan's last beam (a pause closes the sweep anyway). So
+// every possible start s >= `next` of the next scan must give such a scan, judged on the tilt
+// the samples give (interpolated up to the newest one) and, beyond the newest sample, on the
+// assumption that the motor moves on against the direction at least as fast as between the
+// last two samples (it has just turned and accelerates, or cruises). Both changes are piecewise
+// linear in s with corners where s or s + span meets a sample, so checking the corners suffices.
+bool SweepAssembler::tiltProvesReversal() {
+  if (reversalRefuted_ || !hasOpen_ || direction_ == 0 || !lastTilt_ || tilt_.size() < 2 || !newestStart_ ||
+      !minScanGapNs_ || *minScanGapNs_ <= 0)
+    return false;
+  // A received scan waiting for tilt data is the next one; otherwise the next starts no earlier
+  // than the newest stamp plus the shortest gap seen between scan stamps.
+  const Stamp next = pending_.empty() ? *newestStart_ + *minScanGapNs_ : pending_.front().stamp;
+  const drivers::TiltSample& newest = tilt_.back();
+  const drivers::TiltSample& before = tilt_[tilt_.size() - 2];
+  if (newest.stamp - next > static_cast<std::int64_t>(config_.maxScanGapS * 1e9)) {
+    reversalRefuted_ = true;  // a scan after this long a pause closes the sweep by the pause rule
+    return false;
+  }
+  // Against the direction = positive from here on.
+  const double d = -static_cast<double>(direction_);
+  const double lastSlope = d * (newest.angle - before.angle) / static_cast<double>(newest.stamp - before.stamp);
+  if (!(lastSlope > 0)) return false;  // the newest interval does not (yet) show the reversal
+  const double theta = config_.minTiltChange;
+  bool exact = true;  // false once a tilt value beyond the newest sample was needed
+  auto tilt = [&](Stamp t, double& out) {
+    if (t > newest.stamp) {
+      exact = false;
+      out = d * newest.angle + lastSlope * static_cast<double>(t - newest.stamp);
+      return true;
+    }
+    double a = 0;
+    if (!tiltAt(t, a)) return false;
+    out = d * a;
+    return true;
+  };
+  // Corners: next, every sample and sample - span after it up to the newest sample, and the newest
+  // sample itself (beyond it both changes only grow).
+  std::vector<Stamp> corners{next};
+  for (auto it = tilt_.rbegin(); it != tilt_.rend() && it->stamp > next; ++it)
+    for (const Stamp c : {it->stamp, it->stamp - newestSpanNs_})
+      if (c > next) corners.push_back(c);
+  std::sort(corners.begin(), corners.end());
+  const double last = d * *lastTilt_;
+  bool prevIn = false, prevSince = false;
+  for (std::size_t k = 0; k < corners.size(); ++k) {
+    exact = true;
+    double a0 = 0, a1 = 0;
+    if (!tilt(corners[k], a0) || !tilt(corners[k] + newestSpanNs_, a1)) return false;
+    const bool forward = -(a1 - a0) >= theta;   // the scan would keep the sweep's direction
+    const bool in = a1 - a0 >= theta;           // against it inside the scan
+    const bool since = a1 - last >= theta;      // against it since the sweep's last beam
+    // Between two corners both changes are linear: the reversal holds on the whole piece if one
+    // of the two measures holds at both of its ends.
+    const bool pieceOk = k == 0 || (in && prevIn) || (since && prevSince);
+    if (forward || !(in || since) || !pieceOk) {
+      if (exact) reversalRefuted_ = true;  // decided by samples alone: stays so until a scan comes
+      return false;
+    }
+    prevIn = in;
+    prevSince = since;
+  }
+  return true;
 }
 
 void SweepAssembler::useScan(const drivers::LaserScan& scan, const std::vector<double>& tilt) {

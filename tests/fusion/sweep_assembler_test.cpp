@@ -231,3 +231,196 @@ TEST(SweepAssembler, RejectsInvalidReturnsAndBadConfig) {
   bad.tiltAxis = Eigen::Vector3d::Zero();
   EXPECT_THROW(SweepAssembler{bad}, std::invalid_argument);
 }
+
+// When a sweep closes (SweepConfig::closeOnTilt): messages fed in the order the daemon receives
+// them - a tilt sample at its stamp (CAN frames arrive at once), a scan when its telegram is in,
+// 8 ms after its last beam (500 kbaud) - and, for every sweep, the message that emitted it.
+namespace {
+constexpr std::int64_t kTelegramNs = 8'000'000;
+const std::int64_t kScanSpanNs = wallScan(kT0, triangle, 0).beamStamp(200) - Stamp{kT0};  // 6.6 ms
+
+std::int64_t scanStart(int n) { return kT0 + n * kScanNs; }
+
+// Up from -20 deg at 40 deg/s to a peak at `peakNs`, then down at 40 deg/s.
+std::function<double(std::int64_t)> peakAt(std::int64_t peakNs) {
+  return [peakNs](std::int64_t ns) { return (20 - 40 * std::abs(static_cast<double>(ns - peakNs)) * 1e-9) * kPi / 180; };
+}
+
+struct Emitted {
+  enum class By { kTilt, kScan, kFlush } by;
+  std::int64_t stamp;  // of the tilt sample or the scan that emitted it
+  Sweep sweep;
+};
+
+struct Stream {
+  std::function<double(std::int64_t)> tilt;
+  std::int64_t tiltPeriodNs = 10'000'000;
+  std::int64_t tiltPhaseNs = 0;  // samples at kT0 + phase + k * period
+  std::int64_t to = kT0 + 1'500'000'000;  // scans start before this
+  bool interlaced = false;
+  std::function<bool(std::int64_t)> tiltPresent = [](std::int64_t) { return true; };
+};
+
+std::vector<Emitted> run(const Stream& in, bool closeOnTilt, SweepStats* stats = nullptr) {
+  struct Message {
+    std::int64_t arrival;
+    bool scan;
+    std::int64_t stamp;
+  };
+  std::vector<Message> messages;
+  for (std::int64_t t = kT0 - 20'000'000 + in.tiltPhaseNs; t < in.to + 30'000'000; t += in.tiltPeriodNs)
+    if (in.tiltPresent(t)) messages.push_back({t, false, t});
+  for (int n = 0; scanStart(n) < in.to; ++n)
+    messages.push_back({scanStart(n) + (in.interlaced ? 0 : kScanSpanNs) + kTelegramNs, true, scanStart(n)});
+  std::stable_sort(messages.begin(), messages.end(), [](const Message& a, const Message& b) { return a.arrival < b.arrival; });
+  SweepConfig config = wallConfig();
+  config.closeOnTilt = closeOnTilt;
+  SweepAssembler a(config);
+  std::vector<Emitted> out;
+  std::uint64_t seq = 0;
+  for (const Message& m : messages) {
+    if (m.scan)
+      a.addScan(wallScan(m.stamp, in.tilt, seq++, in.interlaced));
+    else
+      a.addTilt(TiltSample{Stamp{m.stamp}, in.tilt(m.stamp), 0});
+    for (Sweep& s : a.takeSweeps()) out.push_back({m.scan ? Emitted::By::kScan : Emitted::By::kTilt, m.stamp, std::move(s)});
+  }
+  a.flush();
+  for (Sweep& s : a.takeSweeps()) out.push_back({Emitted::By::kFlush, 0, std::move(s)});
+  if (stats) *stats = a.stats();
+  return out;
+}
+
+// Same scans in the same sweeps, point for point.
+void expectSameSweeps(const std::vector<Emitted>& a, const std::vector<Emitted>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    const Sweep &x = a[k].sweep, &y = b[k].sweep;
+    EXPECT_EQ(x.id, y.id);
+    EXPECT_EQ(x.start, y.start);
+    EXPECT_EQ(x.end, y.end);
+    ASSERT_EQ(x.size(), y.size()) << "sweep " << k;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      EXPECT_EQ(x.points[i].stampNs, y.points[i].stampNs);
+      EXPECT_EQ(x.points[i].z, y.points[i].z);
+    }
+  }
+}
+}  // namespace
+
+TEST(SweepAssemblerClose, ClosesWhenTheTiltSampleAfterThePeakArrivesNotOnTheNextScan) {
+  // Peak 1 ms after scan 74's last beam (993.3 ms): scans 0-74 rise over their whole span, scan
+  // 75 (from 1000 ms) falls. 100 Hz samples at 5, 15, ... ms: the one at 995 ms is still above
+  // the tilt at scan 74's last beam, the one at 1005 ms is the first below it. Scan 75 reaches
+  // the assembler at 1000 + 6.6 + 8 ms.
+  Stream in;
+  in.tilt = peakAt(scanStart(74) + kScanSpanNs + 1'000'000);
+  in.tiltPhaseNs = 5'000'000;
+  SweepStats stats;
+  const auto early = run(in, true, &stats);
+  const auto late = run(in, false);
+  ASSERT_EQ(early.size(), 2u);
+  EXPECT_EQ(early[0].by, Emitted::By::kTilt);
+  EXPECT_EQ(early[0].stamp, kT0 + 1'005'000'000);
+  EXPECT_EQ(early[0].sweep.size(), 75u * 201);  // scans 0-74, every beam on the wall
+  EXPECT_EQ(early[0].sweep.end, Stamp{scanStart(74) + kScanSpanNs});
+  EXPECT_EQ(early[1].sweep.start, Stamp{scanStart(75)});
+  // Without closeOnTilt scan 75 closes it, once it is in and a sample covers its last beam.
+  EXPECT_EQ(late[0].by, Emitted::By::kTilt);
+  EXPECT_EQ(late[0].stamp, kT0 + 1'015'000'000);
+  expectSameSweeps(early, late);
+  EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
+  EXPECT_EQ(stats.scansUsed, stats.scans);  // none dropped, every used scan in one sweep
+  EXPECT_EQ(stats.points, early[0].sweep.size() + early[1].sweep.size());
+}
+
+TEST(SweepAssemblerClose, AScanThatStraddlesThePeakGoesWhereItsNetTiltChangeSays) {
+  // 1 kHz tilt samples, so the interpolated tilt is the profile. Scan 75 spans 0-6.6 ms after
+  // its stamp; the peak inside it decides by the scan's net change.
+  for (const std::int64_t peakInScan : {2'000'000, 5'000'000}) {
+    SCOPED_TRACE(peakInScan);
+    Stream in;
+    in.tilt = peakAt(scanStart(75) + peakInScan);
+    in.tiltPeriodNs = 1'000'000;
+    const bool rises = peakInScan > kScanSpanNs - peakInScan;  // longer up than down
+    SweepStats stats;
+    const auto early = run(in, true, &stats);
+    const auto late = run(in, false);
+    ASSERT_EQ(early.size(), 2u);
+    const int lastScan = rises ? 75 : 74;
+    EXPECT_EQ(early[0].sweep.size(), static_cast<std::size_t>(lastScan + 1) * 201);
+    EXPECT_EQ(early[1].sweep.start, Stamp{scanStart(lastScan + 1)});
+    if (rises) {
+      // Up 5 ms, down 1.6 ms: no sample can tell before scan 75 is in; it joins the sweep and
+      // closes it - the samples by then show the descent at scan 76's start.
+      EXPECT_EQ(early[0].by, Emitted::By::kScan);
+      EXPECT_EQ(early[0].stamp, scanStart(75));
+    } else {
+      // Up 2 ms, down 4.6 ms: the first sample after the peak (1003 ms) shows scan 75 (and any
+      // later scan) falling over its span, 11.6 ms before scan 75 is in.
+      EXPECT_EQ(early[0].by, Emitted::By::kTilt);
+      EXPECT_EQ(early[0].stamp, kT0 + 1'003'000'000);
+    }
+    // Without closeOnTilt the first falling scan closes it: 75 or 76, once in.
+    EXPECT_EQ(late[0].by, Emitted::By::kScan);
+    EXPECT_EQ(late[0].stamp, scanStart(lastScan + 1));
+    EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
+    expectSameSweeps(early, late);
+  }
+}
+
+TEST(SweepAssemblerClose, InterlacedScansCloseOnTheTiltSampleToo) {
+  // All beams at the scan's stamp: a scan's direction is its tilt against the previous scan's.
+  // Peak on the 100 Hz grid at 1000 ms = scan 75's stamp (interpolation exact): scan 75 is
+  // higher than scan 74 (rising stroke), scan 76 lower. The sample at 1010 ms is the first
+  // below scan 75's tilt; scan 76 (1013.3 ms) arrives at 1021.3 ms.
+  Stream in;
+  in.interlaced = true;
+  in.tilt = peakAt(kT0 + 1'000'000'000);
+  SweepStats stats;
+  const auto early = run(in, true, &stats);
+  const auto late = run(in, false);
+  ASSERT_EQ(early.size(), 2u);
+  EXPECT_EQ(early[0].by, Emitted::By::kTilt);
+  EXPECT_EQ(early[0].stamp, kT0 + 1'010'000'000);
+  EXPECT_EQ(early[0].sweep.size(), 76u * 201);
+  EXPECT_EQ(late[0].by, Emitted::By::kScan);
+  EXPECT_EQ(late[0].stamp, scanStart(76));
+  EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
+  expectSameSweeps(early, late);
+}
+
+TEST(SweepAssemblerClose, WithoutTiltSamplesAfterTheSweepItClosesAsBefore) {
+  const auto peak = scanStart(74) + kScanSpanNs + 1'000'000;
+  {
+    // The tilt stream stops at 990 ms, before scan 74's last beam: nothing proves a reversal,
+    // later scans are dropped without tilt, and only flush() closes the sweep.
+    Stream in;
+    in.tilt = peakAt(peak);
+    in.tiltPresent = [](std::int64_t t) { return t <= kT0 + 990'000'000; };
+    SweepStats stats;
+    const auto early = run(in, true, &stats);
+    ASSERT_EQ(early.size(), 1u);
+    EXPECT_EQ(early[0].by, Emitted::By::kFlush);
+    EXPECT_EQ(early[0].sweep.size(), 74u * 201);  // scans 0-73: 74 ends after the last sample
+    EXPECT_EQ(stats.sweepsClosedOnTilt, 0u);
+    EXPECT_EQ(stats.scansUsed + stats.scansDroppedNoTilt, stats.scans);
+    expectSameSweeps(early, run(in, false));
+  }
+  {
+    // No samples from 990 to 1030 ms (within the 50 ms window): scans 74 and 75 wait for the
+    // sample at 1030 ms, which then decides both - scan 75 closes the sweep, as without closeOnTilt.
+    Stream in;
+    in.tilt = peakAt(peak);
+    in.tiltPresent = [](std::int64_t t) { return t <= kT0 + 990'000'000 || t >= kT0 + 1'030'000'000; };
+    SweepStats stats;
+    const auto early = run(in, true, &stats);
+    const auto late = run(in, false);
+    ASSERT_EQ(early.size(), 2u);
+    EXPECT_EQ(early[0].by, Emitted::By::kTilt);
+    EXPECT_EQ(early[0].stamp, kT0 + 1'030'000'000);
+    EXPECT_EQ(late[0].stamp, kT0 + 1'030'000'000);
+    EXPECT_EQ(stats.sweepsClosedOnTilt, 0u);
+    expectSameSweeps(early, late);
+  }
+}

@@ -298,6 +298,124 @@ TEST(SynthLog, ProceduralReplayLiesOnTheKnownGeometry) {
   }
 }
 
+// One replay through two assemblers, closing on the tilt (the default) and on the next scan:
+// every sweep with the message that emitted it and the newest tilt stamp seen by then (the
+// replay's clock: 100 Hz TPDO1).
+struct ClosedSweep {
+  Sweep sweep;
+  bool byTilt = false;     // emitted while handling a tilt sample (else a scan, or the final flush)
+  std::size_t message = 0; // index of that message in the replay
+  Stamp clock{};
+};
+struct BothWays {
+  std::vector<ClosedSweep> onTilt, onScan;
+  SweepStats stats;  // closing on the tilt
+  std::vector<drivers::TiltSample> tilt;
+};
+BothWays replaySweepsBothWays(const fs::path& log) {
+  const logs::LogSource probe(log);
+  const daemon::Config config = daemon::parseConfig(probe.rig()->configYaml, log.string() + ":config.yaml");
+  SweepConfig onTilt = daemon::sweepConfig(config), onScan = onTilt;
+  EXPECT_TRUE(onTilt.closeOnTilt) << "the daemon closes on the tilt";
+  onScan.closeOnTilt = false;
+  SweepAssembler early(onTilt), late(onScan);
+  BothWays out;
+  std::vector<ClosedSweep>&a = out.onTilt, &b = out.onScan;
+  std::size_t message = 0;
+  bool tiltMessage = false;
+  Stamp clock{};
+  auto take = [&](SweepAssembler& from, std::vector<ClosedSweep>& to) {
+    for (Sweep& s : from.takeSweeps()) to.push_back({std::move(s), tiltMessage, message, clock});
+  };
+  logs::SensorReplay replay(log, daemon::sensorReplayConfig(config));
+  logs::SensorReplay::Handlers h;
+  h.scan = [&](const drivers::LaserScan& s) {
+    early.addScan(s);
+    late.addScan(s);
+    tiltMessage = false;
+  };
+  h.tilt = [&](const drivers::TiltSample& t) {
+    early.addTilt(t);
+    late.addTilt(t);
+    tiltMessage = true;
+    clock = std::max(clock, t.stamp);
+    out.tilt.push_back(t);
+  };
+  h.frame = [&](const drivers::CameraFrame&) { tiltMessage = false; };
+  while (replay.step(h)) {
+    take(early, a);
+    take(late, b);
+    ++message;
+  }
+  tiltMessage = false;
+  early.flush();
+  late.flush();
+  take(early, a);
+  take(late, b);
+  out.stats = early.stats();
+  return out;
+}
+
+// Closing on the tilt assigns every scan as closing on the next scan did (same sweeps, ids,
+// points and stamps), on the demo's log (scripts/demo: synth-log defaults, 6 KITTI strokes) and
+// the procedural one - and emits each sweep no later, on the first TPDO1 sample that shows the
+// tilt moving back (found here from the raw samples): the earliest the samples can tell.
+TEST(SynthLog, SweepsCloseOnTheTiltWithTheSameScansAsOnTheNextScan) {
+  const bool kitti = fs::exists(kKitti / "velodyne");
+  SynthOptions procedural;
+  procedural.frames = 2;
+  std::vector<fs::path> logs{cachedLog("procedural-2-frames.mcap", procedural)};
+  if (kitti) logs.push_back(cachedLog("kitti-6-frames-demo.mcap", SynthOptions{.kitti = kKitti}));
+  for (const fs::path& log : logs) {
+    SCOPED_TRACE(log.filename().string());
+    const BothWays both = replaySweepsBothWays(log);
+    const std::vector<ClosedSweep>&early = both.onTilt, &late = both.onScan;
+    const SweepStats& stats = both.stats;
+    ASSERT_EQ(early.size(), late.size());
+    ASSERT_GE(early.size(), 2u);
+    std::vector<double> gainMs, earlyMs, lateMs;
+    for (std::size_t k = 0; k < early.size(); ++k) {
+      const Sweep &x = early[k].sweep, &y = late[k].sweep;
+      EXPECT_EQ(x.id, y.id);
+      EXPECT_EQ(x.start, y.start);
+      EXPECT_EQ(x.end, y.end);
+      ASSERT_EQ(x.size(), y.size()) << "sweep " << k;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        ASSERT_EQ(x.points[i].stampNs, y.points[i].stampNs);
+        ASSERT_EQ(x.points[i].x, y.points[i].x);
+        ASSERT_EQ(x.points[i].z, y.points[i].z);
+      }
+      EXPECT_LE(early[k].message, late[k].message) << "sweep " << k;
+      if (k + 1 < early.size()) {  // the last one ends with the log (flush)
+        // Expected close: the first sample after the sweep's end that moves opposite to the
+        // last move of the samples up to the end.
+        std::size_t i = 1;
+        while (i < both.tilt.size() && both.tilt[i].stamp <= x.end) ++i;
+        ASSERT_LT(i, both.tilt.size());
+        std::size_t j = i - 1;
+        while (j > 0 && both.tilt[j].angle == both.tilt[j - 1].angle) --j;
+        const double before = both.tilt[j].angle - both.tilt[j - 1].angle;
+        while (i < both.tilt.size() && (both.tilt[i].angle - both.tilt[i - 1].angle) * before >= 0) ++i;
+        ASSERT_LT(i, both.tilt.size());
+        EXPECT_EQ(early[k].clock, both.tilt[i].stamp) << "sweep " << k << ": closed at the first sample moving back";
+        EXPECT_TRUE(early[k].byTilt) << "sweep " << k;
+        earlyMs.push_back(static_cast<double>(early[k].clock - x.end) * 1e-6);
+        lateMs.push_back(static_cast<double>(late[k].clock - y.end) * 1e-6);
+        gainMs.push_back(lateMs.back() - earlyMs.back());
+        std::printf("  sweep %llu: %zu points, ends %.3f s; closed at tilt stamp +%.1f ms (%s), on the next scan +%.1f ms\n",
+                    static_cast<unsigned long long>(x.id), x.size(), static_cast<double>(x.end.ns) * 1e-9, earlyMs.back(),
+                    early[k].byTilt ? "tilt sample" : "scan", lateMs.back());
+      }
+    }
+    std::printf("%s: %zu sweeps, %llu closed on the tilt; newest tilt stamp - sweep end at the close: "
+                "on the tilt median %.1f ms (max %.1f), on the next scan median %.1f ms (max %.1f); earlier by median %.1f ms\n",
+                log.filename().c_str(), early.size(), static_cast<unsigned long long>(stats.sweepsClosedOnTilt),
+                percentile(earlyMs, 0.5), percentile(earlyMs, 1.0), percentile(lateMs, 0.5), percentile(lateMs, 1.0),
+                percentile(gainMs, 0.5));
+    EXPECT_GE(percentile(gainMs, 0.0), 0.0) << "no sweep closes later";
+  }
+}
+
 // Acceptance: a synthesised log cut at 20 random offsets replays without a crash, each up to
 // its last complete chunk, and log info says where it was cut.
 TEST(SynthLog, CutAtTwentyRandomOffsets) {

@@ -11,6 +11,21 @@
 // samples around it. A scan whose beams are not all bracketed by samples at most `tiltWindowS`
 // away is dropped and counted - never extrapolated. Sweeps are split where the tilt direction
 // reverses (and after a pause longer than `maxScanGapS`).
+//
+// Which scans belong to a sweep: a scan whose tilt moves against the sweep's direction (by at
+// least `minTiltChange` within the scan, or - when it moves less inside itself, e.g. interlaced
+// scans - since the previous used scan) starts the next sweep; scans at rest join the open one.
+// When the sweep closes: with `closeOnTilt` as soon as the tilt samples prove that whatever scan
+// comes next moves against the direction - for every start from the earliest the next scan can
+// have (a received scan waiting for tilt: its stamp; else the newest stamp + the shortest gap
+// seen between scan stamps) - so `addTilt` of that sample emits the sweep, up to a scan period
+// plus a telegram before the next scan would have shown it. Beyond the newest sample the proof
+// assumes the motor moves on against the direction at least as fast as between the last two
+// samples (it has just turned: it accelerates or cruises), and that scans come in stamp order.
+// Until the samples prove it (a scan may still start before the turn and straddle it, tilt
+// stream late, missing or at rest, direction unknown, scans out of order) the sweep closes as
+// without `closeOnTilt`: when the first scan against the direction is in. The assignment of
+// scans to sweeps is the same either way.
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -33,6 +48,7 @@ struct SweepConfig {
   double maxRange = 80.0;            // [m] longer returns are dropped
   double maxScanGapS = 1.0;          // a longer pause between scans closes the sweep
   double minTiltChange = 1e-5;       // [rad] over one scan; below it the direction is undecided
+  bool closeOnTilt = true;           // close when the tilt proves the reversal (false: when the next scan shows it)
 };
 
 struct SweepStats {
@@ -42,6 +58,7 @@ struct SweepStats {
   std::uint64_t tiltSamples = 0;
   std::uint64_t tiltOutOfOrder = 0;    // samples not newer than the last one, ignored
   std::uint64_t sweeps = 0;            // sweeps completed
+  std::uint64_t sweepsClosedOnTilt = 0;  // of these, closed by tilt samples before the next scan (closeOnTilt)
   std::uint64_t points = 0;            // points in completed sweeps
 };
 
@@ -68,12 +85,17 @@ class SweepAssembler {
   void process(bool final);
   void useScan(const drivers::LaserScan& scan, const std::vector<double>& tilt);
   void closeSweep();
+  bool tiltProvesReversal();
 
   SweepConfig config_;
   std::int64_t windowNs_;
   std::deque<drivers::TiltSample> tilt_;
   std::deque<drivers::LaserScan> pending_;
-  Stamp newestScan_{};
+  Stamp newestScan_{};             // last beam of the newest scan received
+  std::optional<Stamp> newestStart_;  // first beam of the newest scan received
+  std::optional<std::int64_t> minScanGapNs_;  // shortest gap between consecutive scan stamps seen
+  std::int64_t newestSpanNs_ = 0;             // first to last beam of the newest scan
+  bool reversalRefuted_ = false;  // the samples alone disproved it; stays until a scan comes or is decided
   Sweep open_;
   bool hasOpen_ = false;
   int direction_ = 0;  // +1 rising, -1 falling, 0 not yet known
