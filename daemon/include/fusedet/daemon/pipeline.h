@@ -38,8 +38,9 @@ struct LocatedDetection {
 // Where one stack's time went, in milliseconds: wall time, and the thread's own CPU time where
 // it says Cpu (on a loaded machine wall time also counts waiting for a core).
 struct StageTimes {
-  double closeMs = 0;      // sensor stamp -> fusion starts on the pair: sweep closing (by the next
-                           // stroke's first scan), pairing, the sensor queue
+  double closeMs = 0;      // sensor stamp -> fusion starts on the pair: sweep closing (by the tilt
+                           // sample that proves the turn, else the next stroke's first scan),
+                           // pairing, the sensor queue
   double decodeMs = 0;     // camera frame -> BGR image
   double fuseMs = 0;       // Fuser::fuse: undistortion, camera layers, projection, laser layers
   double fuseCpuMs = 0;    // the fusion thread's CPU time for decode + fuse
