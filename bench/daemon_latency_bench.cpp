@@ -49,6 +49,7 @@ int main(int argc, char** argv) {
   std::string data = FUSEDET_DATA_DIR, models = FUSEDET_SOURCE_DIR "/models", log;
   int frames = 6, passes = 3, threads = 0;
   double speed = 1.0;
+  bool closeOnScan = false;
   app.add_option("--data", data, "root of the shared data (the log is made from its kitti/ folder)")->capture_default_str();
   app.add_option("--models", models, "folder with car.json, bike.json, person.json")->capture_default_str();
   app.add_option("--log", log, "replay this sensor log instead of synthesising one");
@@ -56,6 +57,9 @@ int main(int argc, char** argv) {
   app.add_option("--passes", passes, "times the log is replayed")->capture_default_str();
   app.add_option("--speed", speed, "replay speed (1 = as recorded)")->capture_default_str();
   app.add_option("--threads", threads, "detection threads (0 = all cores)")->capture_default_str();
+  app.add_flag("--close-on-scan", closeOnScan,
+               "close sweeps on the next stroke's first scan (fusion.close_on_tilt false), the rule before "
+               "closing on the tilt sample that proves the turn: the peer for the close stage");
   CLI11_PARSE(app, argc, argv);
   const std::string loadAtStart = loadAverage();
 
@@ -81,6 +85,7 @@ int main(int argc, char** argv) {
   config.replay.speed = speed;
   config.replay.restamp = true;  // stamps = when the sensor would have measured: latencies are real
   config.replay.atEnd = "loop";
+  config.fusion.closeOnTilt = !closeOnScan;
   ServiceParts parts = replayParts(config, {});
   parts.listener = bindUnixSocket(config.socket.path);
   Service service(std::move(parts));
@@ -121,13 +126,16 @@ int main(int argc, char** argv) {
   fs::remove_all(tmp);
 
   std::printf("daemon latency, replay: %s; %d passes at %.2fx recorded speed, re-stamped; classes car bike person, "
-              "detection threads %d (0 = all), %u cores\n",
-              scene.c_str(), passes, speed, threads, std::thread::hardware_concurrency());
+              "detection threads %d (0 = all), %u cores; sweeps close on %s\n",
+              scene.c_str(), passes, speed, threads, std::thread::hardware_concurrency(),
+              closeOnScan ? "the next scan (--close-on-scan)" : "the tilt sample that proves the turn (default)");
   std::printf("load average (/proc/loadavg 1/5/15 min) at start: %s, at end: %s\n", loadAtStart.c_str(),
               loadAverage().c_str());
-  std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind), %llu unpaired sweeps\n",
+  std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind), %llu unpaired sweeps; "
+              "sweeps %llu, closed by a tilt sample %llu\n",
               latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),
-              static_cast<unsigned long long>(c.unpaired));
+              static_cast<unsigned long long>(c.unpaired), static_cast<unsigned long long>(c.sweeps.sweeps),
+              static_cast<unsigned long long>(c.sweeps.sweepsClosedOnTilt));
   if (latency.empty()) {
     std::fprintf(stderr, "bench_daemon_latency: no stack reached the client: %s\n", status.dump().c_str());
     return 1;

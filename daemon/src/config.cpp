@@ -174,6 +174,7 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.readRange("hole_fill_radius", c.fusion.holeFillRadius, 0, 32);
     s.readRange("max_pair_skew_ms", c.fusion.maxPairSkewMs, 0, 10000);
     s.readRange("tilt_window_ms", c.fusion.tiltWindowMs, 1, 10000);
+    s.read("close_on_tilt", c.fusion.closeOnTilt);
     s.finish();
   }
   {
@@ -279,7 +280,8 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "laser_layer_scale" << YAML::Value << c.fusion.laserLayerScale;
   out << YAML::Key << "hole_fill_radius" << YAML::Value << c.fusion.holeFillRadius;
   out << YAML::Key << "max_pair_skew_ms" << YAML::Value << c.fusion.maxPairSkewMs;
-  out << YAML::Key << "tilt_window_ms" << YAML::Value << c.fusion.tiltWindowMs << YAML::EndMap;
+  out << YAML::Key << "tilt_window_ms" << YAML::Value << c.fusion.tiltWindowMs;
+  out << YAML::Key << "close_on_tilt" << YAML::Value << c.fusion.closeOnTilt << YAML::EndMap;
   out << YAML::Key << "detection" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "models" << YAML::Value;
   seq(c.detection.models);

@@ -24,6 +24,7 @@ fusion::SweepConfig sweepConfig(const Config& c) {
   fusion::SweepConfig s;
   s.tiltAxisOffset = Eigen::Vector3d(c.fusion.tiltAxisOffset[0], c.fusion.tiltAxisOffset[1], c.fusion.tiltAxisOffset[2]);
   s.tiltWindowS = c.fusion.tiltWindowMs * 1e-3;
+  s.closeOnTilt = c.fusion.closeOnTilt;
   s.remissionFullScale = c.laser.remission ? c.laser.remissionFullScale : 1.0;
   return s;
 }

@@ -1,4 +1,5 @@
 #include "fusedet/daemon/config.h"
+#include "fusedet/daemon/rig.h"
 
 #include <gtest/gtest.h>
 
@@ -82,6 +83,14 @@ TEST(Config, ReplayKeys) {
   EXPECT_EQ(errorOf("replay:\n  restamp: false\n  at_end: loop\n"),
             "test.yaml:3: key replay.at_end: loop needs replay.restamp true (stamps must keep increasing)");
   EXPECT_EQ(errorOf("replay:\n  speed: 0\n"), "test.yaml:2: key replay.speed: 0 is outside [0.01, 100]");
+}
+
+TEST(Config, CloseOnTiltReachesTheSweepAssembly) {
+  EXPECT_TRUE(sweepConfig(Config{}).closeOnTilt);
+  const Config off = parseConfig("fusion:\n  close_on_tilt: false\n", "f.yaml");
+  EXPECT_FALSE(sweepConfig(off).closeOnTilt);
+  EXPECT_FALSE(parseConfig(dumpConfig(off), "dump.yaml").fusion.closeOnTilt);
+  EXPECT_NE(errorOf("fusion:\n  close_on_tilt: maybe\n").find("test.yaml:2"), std::string::npos);
 }
 
 TEST(Config, DemoFileLoadsAndNamesTheBundledModels) {

@@ -302,7 +302,9 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
   // sweeps cut at the seam, frames unpaired, scans without tilt).
   EXPECT_EQ(status["pipeline"]["unpaired_sweeps"], 0) << status.dump();
   EXPECT_EQ(status["pipeline"]["scans_dropped_no_tilt"], 0) << status.dump();
-  EXPECT_GE(status["pipeline"]["stacks_fused"].get<int>(), kStrokes * status["sensors"][0]["passes"].get<int>());
+  // The replay counts a pass when it reaches the log's end; fusion may still be on that pass's
+  // last messages (up to half the 512-message sensor queue, less than a pass) when status is read.
+  EXPECT_GE(status["pipeline"]["stacks_fused"].get<int>(), kStrokes * (status["sensors"][0]["passes"].get<int>() - 1));
   // Stamps ahead of the clock are no latency: none is reported (it was negative).
   EXPECT_EQ(status["latency_ms"]["samples"], 0) << status.dump();
   for (auto& s : silent) {

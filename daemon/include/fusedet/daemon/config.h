@@ -70,6 +70,7 @@ struct Config {
     int holeFillRadius = 2;
     int maxPairSkewMs = 150;
     int tiltWindowMs = 50;
+    bool closeOnTilt = true;  // a tilt sample that proves the turn closes a sweep (false: the next scan)
   } fusion;
 
   struct Detection {
