@@ -18,7 +18,6 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -34,6 +33,7 @@
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
+#include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/kitti.h"
 
 namespace {
@@ -44,16 +44,6 @@ using namespace fusedet::boosting;
 
 const fs::path kFace = "/usr/share/opencv4/haarcascades/haarcascade_frontalface_default.xml";
 
-double threadCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
-double processCpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
-}
 double wallMs() {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }

@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/frame_decode.h"
 
 namespace fusedet::daemon {

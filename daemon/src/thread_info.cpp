@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -28,12 +27,6 @@ class TbbWorkerNames::Observer : public tbb::task_scheduler_observer {
 
 TbbWorkerNames::TbbWorkerNames(std::string name) : observer_(std::make_unique<Observer>(std::move(name))) {}
 TbbWorkerNames::~TbbWorkerNames() = default;
-
-double threadCpuMs() {
-  timespec t{};
-  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) * 1e3 + static_cast<double>(t.tv_nsec) * 1e-6;
-}
 
 std::vector<ThreadCpu> processThreadCpu() {
   std::vector<ThreadCpu> out;

@@ -1,7 +1,7 @@
 #pragma once
 // Thread names and CPU times: the daemon's threads carry names (visible in `top -H`, `ps -L`,
 // perf) and its stage timings report CPU time beside wall time, since on a shared machine wall
-// time also counts waiting for a core.
+// time also counts waiting for a core (the calling thread's CPU clock: core/cpu_time.h threadCpuMs()).
 
 #include <memory>
 #include <string>
@@ -11,9 +11,6 @@ namespace fusedet::daemon {
 
 // Names the calling thread (Linux keeps the first 15 characters).
 void nameThisThread(const std::string& name);
-
-// CPU time the calling thread has used, in milliseconds (CLOCK_THREAD_CPUTIME_ID).
-double threadCpuMs();
 
 // While it lives, TBB's worker threads that work in the creating thread's arena (the detection
 // scan's helpers) are named `name`; they would otherwise carry the name of whichever thread
