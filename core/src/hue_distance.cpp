@@ -1,5 +1,6 @@
 #include "fusedet/core/hue_distance.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,20 +11,35 @@ double hueDistanceDeg(double hueDeg, double referenceDeg) {
   return d > 180.0 ? 360.0 - d : d;
 }
 
+namespace {
+
+float wrappedReference(double referenceDeg) {
+  return static_cast<float>(std::fmod(std::fmod(referenceDeg, 360.0) + 360.0, 360.0));
+}
+
+// Both in [0, 360): |h - ref| < 360, so one fold is enough. "d > 180 ? 360 - d : d" is written
+// as a minimum - the same value for every d, NaN included (std::min returns its first argument
+// unless the second is smaller) - so that the loops below vectorise instead of branching on
+// every pixel (hue is noise to a branch predictor; the detector derives this per model and stack).
+inline float foldedDistance(float hue, float ref) {
+  const float d = std::fabs(hue - ref);
+  return std::min(d, 360.f - d);
+}
+
+}  // namespace
+
 void hueDistanceRow(const float* in, float* o, int n, double referenceDeg) {
-  const auto ref = static_cast<float>(std::fmod(std::fmod(referenceDeg, 360.0) + 360.0, 360.0));
-  for (int x = 0; x < n; ++x) {
-    // Both in [0, 360): |h - ref| < 360, so one fold is enough.
-    const float d = std::fabs(in[x] - ref);
-    o[x] = d > 180.f ? 360.f - d : d;
-  }
+  const float ref = wrappedReference(referenceDeg);
+  for (int x = 0; x < n; ++x) o[x] = foldedDistance(in[x], ref);
 }
 
 void hueDistanceRow(const float* in, const unsigned char* valid, float* o, int n, double referenceDeg) {
-  hueDistanceRow(in, o, n, referenceDeg);
-  if (valid)
-    for (int x = 0; x < n; ++x)
-      if (!valid[x]) o[x] = kNoHueDistance;
+  if (!valid) return hueDistanceRow(in, o, n, referenceDeg);
+  const float ref = wrappedReference(referenceDeg);
+  for (int x = 0; x < n; ++x) {
+    const float d = foldedDistance(in[x], ref);
+    o[x] = valid[x] ? d : kNoHueDistance;
+  }
 }
 
 cv::Mat hueDistanceLayer(const cv::Mat& hueDeg, const cv::Mat& valid, double referenceDeg) {

@@ -2,6 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <vector>
+
 #include <opencv2/core.hpp>
 
 TEST(HueDistance, WrapsAroundZero) {
@@ -38,4 +44,36 @@ TEST(HueDistance, PixelsWithoutHueAreNeutral) {
   const cv::Mat all = fusedet::hueDistanceLayer(hue, cv::Mat(), 0.0);
   EXPECT_EQ(all.at<float>(0, 0), 0.f);
   EXPECT_THROW((void)fusedet::hueDistanceLayer(hue, cv::Mat(2, 2, CV_8UC1), 0.0), std::invalid_argument);
+}
+
+// The row functions (vectorised) give exactly the per-pixel rule "d = |h - ref|; d > 180 ? 360 - d
+// : d" (masked pixels kNoHueDistance), bit for bit: dense hues around the fold at 180, the wrap,
+// NaN, and row lengths that leave vector remainders; with and without a mask.
+TEST(HueDistance, RowsEqualThePerPixelRuleBitForBit) {
+  std::vector<float> hues;
+  for (int i = 0; i <= 3600; ++i) hues.push_back(0.1f * float(i));  // 0 .. 360 in 0.1 steps (float rounding)
+  for (float h : {179.99998f, 180.f, 180.00002f, 0.f, 359.99997f, 1e-30f}) hues.push_back(h);
+  hues.push_back(std::numeric_limits<float>::quiet_NaN());
+  std::vector<unsigned char> valid(hues.size());
+  for (std::size_t i = 0; i < valid.size(); ++i) valid[i] = (i * 7 % 5) ? 255 : 0;
+  for (double reference : {0.0, 10.0, 179.5, 180.0, 350.0, -30.0, 725.25}) {
+    const auto ref = static_cast<float>(std::fmod(std::fmod(reference, 360.0) + 360.0, 360.0));
+    for (int n : {1, 3, 7, 8, 9, 17, static_cast<int>(hues.size())}) {
+      std::vector<float> plain(static_cast<std::size_t>(n)), masked(static_cast<std::size_t>(n));
+      fusedet::hueDistanceRow(hues.data(), plain.data(), n, reference);
+      fusedet::hueDistanceRow(hues.data(), valid.data(), masked.data(), n, reference);
+      for (int x = 0; x < n; ++x) {
+        const float d = std::fabs(hues[static_cast<std::size_t>(x)] - ref);
+        const float expected = d > 180.f ? 360.f - d : d;
+        const float expectedMasked = valid[static_cast<std::size_t>(x)] ? expected : fusedet::kNoHueDistance;
+        std::uint32_t a = 0, b = 0, c = 0, e = 0;
+        std::memcpy(&a, &plain[static_cast<std::size_t>(x)], 4);
+        std::memcpy(&b, &expected, 4);
+        std::memcpy(&c, &masked[static_cast<std::size_t>(x)], 4);
+        std::memcpy(&e, &expectedMasked, 4);
+        ASSERT_EQ(a, b) << "hue " << hues[static_cast<std::size_t>(x)] << " reference " << reference;
+        ASSERT_EQ(c, e) << "hue " << hues[static_cast<std::size_t>(x)] << " reference " << reference;
+      }
+    }
+  }
 }
