@@ -7,11 +7,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <tuple>
 
+#include "fusedet/boost/float_cut.h"
 #include "opencv_pyramid.h"
 
 #if defined(__x86_64__) && defined(__GNUC__)
@@ -35,10 +38,27 @@ struct GridStump {
   bool whiteIsRest = false;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
+  // The vector paths' quick form (stumps on layers that are not contrast-normalised): value' =
+  // black * invBlackArea - white * invWhiteArea differs from the exact value (divisions) by less
+  // than kQuickMargin(value'), and the exact value rounded to float is below `threshold` iff the
+  // exact value is below `cut` (float_cut.h). So where |value' - cut| exceeds the margin, value' <
+  // cut is the stump's decision; the rare windows closer than that are computed exactly.
+  double invBlackArea = 1, invWhiteArea = 1, cut = 0;
   float threshold = 0;
   int contrast = -1;  // contrast-normalised: index into GridScale::contrasts, else -1 (fills padding)
   double left = 0, right = 0;
 };
+
+// Bound on |value' - value| (see GridStump) for black/blackArea = a, white/whiteArea = b:
+// a * (1/area) in double is within 2u|a| of a (u = 2^-53: the rounded reciprocal, the product),
+// the exact path's quotient within u|a|, and each difference within u of its result, so
+// |value' - value| <= 6u(|a'| + |b'|) (a', b' the products; second-order terms included). The
+// margin is 16u(|a'| + |b'|) plus 2^-1000 for results in the subnormal range. Infinite or NaN
+// values make the test fail, so they take the exact path.
+constexpr double kQuickMarginRelative = 0x1p-49;
+constexpr double kQuickMarginAbsolute = 0x1p-1000;
+
+std::atomic<bool> gQuickDecisions{true};
 
 // The contrast (feature.h: windowContrast) of one normalised layer on a window: the layer window's
 // corners as offsets from the window's origin in the grid of the layer's sums and in the (double)
@@ -64,12 +84,16 @@ struct GridScale {
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
   std::vector<GridContrast> contrasts;  // one per contrast-normalised layer the stumps read
+  // kQuickMarginRelative, or +inf when quick decisions are off (setQuickStumpDecisions): then no
+  // lane is ever sure and every stump takes the exact fallback.
+  double quickMarginRelative = kQuickMarginRelative;
 };
 
 // slots[l]: where layer l's sums live; sqSlots[l]: its squared sums (contrast-normalised layers).
 GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector<SlotRef>& slots,
                     const std::vector<SlotRef>& sqSlots, ScaleWindows win) {
   GridScale sp;
+  if (!gQuickDecisions.load(std::memory_order_relaxed)) sp.quickMarginRelative = std::numeric_limits<double>::infinity();
   const int W = in.refWidth(), H = in.refHeight();
   const std::size_t ng = in.grids().size();
   sp.colOfs.resize(ng);
@@ -142,7 +166,10 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
       z.blackArea = lay.blackArea;
       z.whiteArea = lay.whiteArea;
+      z.invBlackArea = 1.0 / lay.blackArea;
+      z.invWhiteArea = 1.0 / lay.whiteArea;
       z.threshold = static_cast<float>(t.threshold);
+      z.cut = floatCut(z.threshold);
       z.left = t.left;
       z.right = t.right;
       z.contrast = contrastOf[static_cast<std::size_t>(f.layer)];
@@ -177,7 +204,9 @@ struct WindowList {
   }
   std::int32_t* offsets(std::size_t g) { return off.data() + g * cap; }
   double* contrastOf(std::size_t k) { return contrast.data() + k * cap; }
-  void pad(std::size_t n) {
+  // Inlined into the vector loops: an out-of-line call from there into baseline (SSE) code costs a
+  // vector-state transition per stage.
+  [[gnu::always_inline]] inline void pad(std::size_t n) {
     for (std::size_t g = 0; g < grids; ++g)
       for (std::size_t k = n; k < n + kPad; ++k) offsets(g)[k] = n ? offsets(g)[0] : 0;
     for (std::size_t c = 0; c < contrasts; ++c)
@@ -258,6 +287,34 @@ constexpr std::size_t kMaxVectorContrasts = 16;  // contrast-normalised layers o
 // so that the AVX2 copy holds no AVX-512 instruction. Every lane does the scalar path's operations
 // in the same order (add/sub/div, no FMA), so the lanes equal stageScalar() bit for bit.
 
+// Tables for compressing four lanes (AVX2 has no compress instruction): for each mask of lanes to
+// keep, the source lane of each destination lane, as bytes of 32-bit lanes (kCompressBytes) and as
+// 32-bit halves of 64-bit lanes (kCompressPairs).
+constexpr std::array<int, 4> compressOrder(int keep) {
+  std::array<int, 4> src{0, 0, 0, 0};
+  int n = 0;
+  for (int k = 0; k < 4; ++k)
+    if ((keep >> k) & 1) src[static_cast<std::size_t>(n++)] = k;
+  return src;
+}
+constexpr std::array<std::array<std::int8_t, 16>, 16> kCompressBytes = [] {
+  std::array<std::array<std::int8_t, 16>, 16> t{};
+  for (int m = 0; m < 16; ++m)
+    for (int d = 0; d < 4; ++d)
+      for (int b = 0; b < 4; ++b)
+        t[static_cast<std::size_t>(m)][static_cast<std::size_t>(4 * d + b)] =
+            static_cast<std::int8_t>(4 * compressOrder(m)[static_cast<std::size_t>(d)] + b);
+  return t;
+}();
+constexpr std::array<std::array<std::int32_t, 8>, 16> kCompressPairs = [] {
+  std::array<std::array<std::int32_t, 8>, 16> t{};
+  for (int m = 0; m < 16; ++m)
+    for (int d = 0; d < 4; ++d)
+      for (int h = 0; h < 2; ++h)
+        t[static_cast<std::size_t>(m)][static_cast<std::size_t>(2 * d + h)] = 2 * compressOrder(m)[static_cast<std::size_t>(d)] + h;
+  return t;
+}();
+
 #pragma GCC push_options
 #pragma GCC target("avx2")
 namespace avx2 {
@@ -271,6 +328,16 @@ struct Lanes {
   static Ints splat(std::int32_t v) { return _mm_set1_epi32(v); }
   static Ints add(Ints a, Ints b) { return _mm_add_epi32(a, b); }
   static Ints sub(Ints a, Ints b) { return _mm_sub_epi32(a, b); }
+  static Ints iota(std::int32_t first) { return _mm_add_epi32(_mm_set1_epi32(first), _mm_setr_epi32(0, 1, 2, 3)); }
+  // The lanes whose bit is set in `keep`, moved to the front (in order; the rest is don't-care):
+  // byte shuffles from a table of the 16 masks.
+  static Ints compress(Ints v, int keep) {
+    return _mm_shuffle_epi8(v, _mm_loadu_si128(reinterpret_cast<const __m128i*>(kCompressBytes[keep].data())));
+  }
+  static Doubles compress(Doubles v, int keep) {
+    const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kCompressPairs[keep].data()));
+    return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), idx));
+  }
   // Corner values of the windows, gathered (origins b + o[k]) or, for neighbours whose origins are
   // `stride` (1 or 2) apart, loaded from the first one's origin b. The same values either way.
   static Doubles corners(const double* b, Ints o, int stride) {
@@ -302,11 +369,15 @@ struct Lanes {
   static Doubles max(Doubles a, Doubles b) { return _mm256_max_pd(a, b); }
   static Doubles load(const double* p) { return _mm256_loadu_pd(p); }
   static Doubles roundToFloat(Doubles v) { return _mm256_cvtps_pd(_mm256_cvtpd_ps(v)); }
-  // v < threshold ? left : right, per lane.
-  static Doubles choose(Doubles v, double threshold, double left, double right) {
-    const __m256d lt = _mm256_cmp_pd(v, splat(threshold), _CMP_LT_OQ);
-    return _mm256_blendv_pd(splat(right), splat(left), lt);
-  }
+  static Doubles abs(Doubles v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
+  // Per-lane truth values: all bits of a lane set where true.
+  using Mask = __m256d;
+  static Mask less(Doubles a, Doubles b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+  static Mask greater(Doubles a, Doubles b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+  static bool all(Mask m) { return _mm256_movemask_pd(m) == 0xF; }
+  static Mask select(Mask pick, Mask a, Mask b) { return _mm256_blendv_pd(b, a, pick); }  // pick ? a : b
+  // lt ? left : right, per lane.
+  static Doubles choose(Mask lt, double left, double right) { return _mm256_blendv_pd(splat(right), splat(left), lt); }
   // Bit k set where !(sum[k] < threshold): window k passes the stage.
   static int passMask(Doubles sum, double threshold) {
     return _mm256_movemask_pd(_mm256_cmp_pd(sum, splat(threshold), _CMP_NLT_UQ));
@@ -318,10 +389,11 @@ struct Lanes {
 #pragma GCC pop_options
 
 #pragma GCC push_options
-#pragma GCC target("avx512f")
-// GCC 12's AVX-512 intrinsics start from undefined vectors, which -Wmaybe-uninitialized flags.
+#pragma GCC target("avx512f,avx512vl")
+// GCC 12's AVX-512 intrinsics start from undefined vectors, which -W(maybe-)uninitialized flags.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 namespace avx512 {
 // Eight windows per step: int32 offsets and table values in __m256i, doubles in __m512d.
 struct Lanes {
@@ -333,6 +405,11 @@ struct Lanes {
   static Ints splat(std::int32_t v) { return _mm256_set1_epi32(v); }
   static Ints add(Ints a, Ints b) { return _mm256_add_epi32(a, b); }
   static Ints sub(Ints a, Ints b) { return _mm256_sub_epi32(a, b); }
+  static Ints iota(std::int32_t first) {
+    return _mm256_add_epi32(_mm256_set1_epi32(first), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  }
+  static Ints compress(Ints v, int keep) { return _mm256_maskz_compress_epi32(static_cast<__mmask8>(keep), v); }
+  static Doubles compress(Doubles v, int keep) { return _mm512_maskz_compress_pd(static_cast<__mmask8>(keep), v); }
   static Doubles corners(const double* b, Ints o, int stride) {  // as avx2::Lanes::corners
     if (stride == 1) return _mm512_loadu_pd(b);
     if (stride == 2)
@@ -361,9 +438,13 @@ struct Lanes {
   static Doubles max(Doubles a, Doubles b) { return _mm512_max_pd(a, b); }
   static Doubles load(const double* p) { return _mm512_loadu_pd(p); }
   static Doubles roundToFloat(Doubles v) { return _mm512_cvtps_pd(_mm512_cvtpd_ps(v)); }
-  static Doubles choose(Doubles v, double threshold, double left, double right) {
-    return _mm512_mask_blend_pd(_mm512_cmp_pd_mask(v, splat(threshold), _CMP_LT_OQ), splat(right), splat(left));
-  }
+  static Doubles abs(Doubles v) { return _mm512_abs_pd(v); }
+  using Mask = __mmask8;
+  static Mask less(Doubles a, Doubles b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+  static Mask greater(Doubles a, Doubles b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+  static bool all(Mask m) { return m == 0xFF; }
+  static Mask select(Mask pick, Mask a, Mask b) { return static_cast<Mask>((pick & a) | (~pick & b)); }
+  static Doubles choose(Mask lt, double left, double right) { return _mm512_mask_blend_pd(lt, splat(right), splat(left)); }
   static int passMask(Doubles sum, double threshold) {
     return static_cast<int>(_mm512_cmp_pd_mask(sum, splat(threshold), _CMP_NLT_UQ));
   }
@@ -376,7 +457,7 @@ struct Lanes {
 
 // Widest path the CPU, the vector switch and the lane limit allow: 8, 4 or 1 lanes.
 int vectorLanes(std::size_t grids) {
-  static const bool avx2 = __builtin_cpu_supports("avx2"), avx512 = __builtin_cpu_supports("avx512f");
+  static const bool avx2 = __builtin_cpu_supports("avx2"), avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
   if (!vectorScanEnabled() || grids > kMaxVectorGrids) return 1;
   const int limit = vectorLanesLimit();
   if (avx512 && limit >= 8) return 8;
@@ -454,6 +535,8 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
 }
 
 }  // namespace
+
+void setQuickStumpDecisions(bool enabled) { gQuickDecisions = enabled; }
 
 std::vector<ScaleWindows> windowScales(const Cascade& c, int W, int H, const ScanParams& params) {
   if (!(params.scaleFactor > 1)) throw std::invalid_argument("scale factor must be > 1");
