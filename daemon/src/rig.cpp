@@ -63,6 +63,7 @@ ReplayRig replayRig(const std::filesystem::path& log, const Config& machine, con
     out.config.tilt = recorded.tilt;
     out.config.camera = recorded.camera;
     out.config.fusion = recorded.fusion;
+    out.config.fusion.closeOnTilt = machine.fusion.closeOnTilt;  // how this machine closes sweeps, not the rig's
     out.origin = log.string() + " (metadata fusedet.config)";
   } else {
     out.origin = "the machine config (the log carries no fusedet.config)";

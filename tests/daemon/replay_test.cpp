@@ -12,6 +12,7 @@
 
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/replay_source.h"
+#include "fusedet/daemon/rig.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/service_parts.h"
 #include "fusedet/drivers/log/mcap_reader.h"
@@ -315,6 +316,20 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
   const auto t0 = std::chrono::steady_clock::now();
   service->stop(t0 + 1500ms);
   EXPECT_LT(std::chrono::steady_clock::now() - t0, 2s);
+}
+
+// The log's rig replaces the fusion section, but how sweeps close is this machine's choice.
+TEST(ReplayService, CloseOnTiltComesFromTheMachineConfigNotTheLog) {
+  const std::filesystem::path log = testlogs::daemonTestLog(1);
+  for (const bool onTilt : {true, false}) {
+    Config machine;
+    machine.fusion.closeOnTilt = onTilt;
+    machine.fusion.tiltWindowMs = 7;  // a rig value: the log's (default 50) wins
+    const ReplayRig rig = replayRig(log, machine, {});
+    EXPECT_EQ(rig.config.fusion.closeOnTilt, onTilt);
+    EXPECT_EQ(sweepConfig(rig.config).closeOnTilt, onTilt);
+    EXPECT_EQ(rig.config.fusion.tiltWindowMs, 50);
+  }
 }
 
 TEST(ReplayService, ACutLogReplaysWhatIsIntactAndGarbageIsAClearError) {
