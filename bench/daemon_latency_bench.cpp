@@ -144,6 +144,11 @@ int main(int argc, char** argv) {
               percentile(latency, 0.5), percentile(latency, 0.9), percentile(latency, 0.99), percentile(latency, 1.0));
   std::printf("%-44s p50 %8.1f  p90 %8.1f  p99 %8.1f  max %8.1f ms\n", "fuse + detect only, same stacks (floor)",
               percentile(compute, 0.5), percentile(compute, 0.9), percentile(compute, 0.99), percentile(compute, 1.0));
+  // Nearest rank (daemon::percentile): p99 of 100 or fewer values is the largest; the largest of n
+  // values sits near the n/(n+1) quantile, so few stacks make an optimistic p99.
+  if (latency.size() <= 100)
+    std::printf("(p99 of %zu stacks = the slowest one; more than 100 stacks, e.g. --passes 17 of 6 strokes, for one that is not)\n",
+                latency.size());
   auto row = [](const char* what, const std::vector<double>& v) {
     std::printf("  %-42s p50 %8.1f  p90 %8.1f  p99 %8.1f  max %8.1f ms\n", what, percentile(v, 0.5),
                 percentile(v, 0.9), percentile(v, 0.99), percentile(v, 1.0));

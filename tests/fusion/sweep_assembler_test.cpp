@@ -306,6 +306,19 @@ void expectSameSweeps(const std::vector<Emitted>& a, const std::vector<Emitted>&
     }
   }
 }
+
+// The stream with closeOnTilt (early) and without (late): the same sweeps either way.
+struct BothRules {
+  std::vector<Emitted> early, late;
+  SweepStats stats;  // of early
+};
+BothRules runBoth(const Stream& in) {
+  BothRules r;
+  r.early = run(in, true, &r.stats);
+  r.late = run(in, false);
+  expectSameSweeps(r.early, r.late);
+  return r;
+}
 }  // namespace
 
 TEST(SweepAssemblerClose, ClosesWhenTheTiltSampleAfterThePeakArrivesNotOnTheNextScan) {
@@ -316,9 +329,7 @@ TEST(SweepAssemblerClose, ClosesWhenTheTiltSampleAfterThePeakArrivesNotOnTheNext
   Stream in;
   in.tilt = peakAt(scanStart(74) + kScanSpanNs + 1'000'000);
   in.tiltPhaseNs = 5'000'000;
-  SweepStats stats;
-  const auto early = run(in, true, &stats);
-  const auto late = run(in, false);
+  const auto [early, late, stats] = runBoth(in);
   ASSERT_EQ(early.size(), 2u);
   EXPECT_EQ(early[0].by, Emitted::By::kTilt);
   EXPECT_EQ(early[0].stamp, kT0 + 1'005'000'000);
@@ -328,7 +339,6 @@ TEST(SweepAssemblerClose, ClosesWhenTheTiltSampleAfterThePeakArrivesNotOnTheNext
   // Without closeOnTilt scan 75 closes it, once it is in and a sample covers its last beam.
   EXPECT_EQ(late[0].by, Emitted::By::kTilt);
   EXPECT_EQ(late[0].stamp, kT0 + 1'015'000'000);
-  expectSameSweeps(early, late);
   EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
   EXPECT_EQ(stats.scansUsed, stats.scans);  // none dropped, every used scan in one sweep
   EXPECT_EQ(stats.points, early[0].sweep.size() + early[1].sweep.size());
@@ -343,9 +353,7 @@ TEST(SweepAssemblerClose, AScanThatStraddlesThePeakGoesWhereItsNetTiltChangeSays
     in.tilt = peakAt(scanStart(75) + peakInScan);
     in.tiltPeriodNs = 1'000'000;
     const bool rises = peakInScan > kScanSpanNs - peakInScan;  // longer up than down
-    SweepStats stats;
-    const auto early = run(in, true, &stats);
-    const auto late = run(in, false);
+    const auto [early, late, stats] = runBoth(in);
     ASSERT_EQ(early.size(), 2u);
     const int lastScan = rises ? 75 : 74;
     EXPECT_EQ(early[0].sweep.size(), static_cast<std::size_t>(lastScan + 1) * 201);
@@ -365,7 +373,6 @@ TEST(SweepAssemblerClose, AScanThatStraddlesThePeakGoesWhereItsNetTiltChangeSays
     EXPECT_EQ(late[0].by, Emitted::By::kScan);
     EXPECT_EQ(late[0].stamp, scanStart(lastScan + 1));
     EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
-    expectSameSweeps(early, late);
   }
 }
 
@@ -377,9 +384,7 @@ TEST(SweepAssemblerClose, InterlacedScansCloseOnTheTiltSampleToo) {
   Stream in;
   in.interlaced = true;
   in.tilt = peakAt(kT0 + 1'000'000'000);
-  SweepStats stats;
-  const auto early = run(in, true, &stats);
-  const auto late = run(in, false);
+  const auto [early, late, stats] = runBoth(in);
   ASSERT_EQ(early.size(), 2u);
   EXPECT_EQ(early[0].by, Emitted::By::kTilt);
   EXPECT_EQ(early[0].stamp, kT0 + 1'010'000'000);
@@ -387,7 +392,6 @@ TEST(SweepAssemblerClose, InterlacedScansCloseOnTheTiltSampleToo) {
   EXPECT_EQ(late[0].by, Emitted::By::kScan);
   EXPECT_EQ(late[0].stamp, scanStart(76));
   EXPECT_EQ(stats.sweepsClosedOnTilt, 1u);
-  expectSameSweeps(early, late);
 }
 
 TEST(SweepAssemblerClose, WithoutTiltSamplesAfterTheSweepItClosesAsBefore) {
@@ -398,14 +402,12 @@ TEST(SweepAssemblerClose, WithoutTiltSamplesAfterTheSweepItClosesAsBefore) {
     Stream in;
     in.tilt = peakAt(peak);
     in.tiltPresent = [](std::int64_t t) { return t <= kT0 + 990'000'000; };
-    SweepStats stats;
-    const auto early = run(in, true, &stats);
+    const auto [early, late, stats] = runBoth(in);
     ASSERT_EQ(early.size(), 1u);
     EXPECT_EQ(early[0].by, Emitted::By::kFlush);
     EXPECT_EQ(early[0].sweep.size(), 74u * 201);  // scans 0-73: 74 ends after the last sample
     EXPECT_EQ(stats.sweepsClosedOnTilt, 0u);
     EXPECT_EQ(stats.scansUsed + stats.scansDroppedNoTilt, stats.scans);
-    expectSameSweeps(early, run(in, false));
   }
   {
     // No samples from 990 to 1030 ms (within the 50 ms window): scans 74 and 75 wait for the
@@ -413,14 +415,11 @@ TEST(SweepAssemblerClose, WithoutTiltSamplesAfterTheSweepItClosesAsBefore) {
     Stream in;
     in.tilt = peakAt(peak);
     in.tiltPresent = [](std::int64_t t) { return t <= kT0 + 990'000'000 || t >= kT0 + 1'030'000'000; };
-    SweepStats stats;
-    const auto early = run(in, true, &stats);
-    const auto late = run(in, false);
+    const auto [early, late, stats] = runBoth(in);
     ASSERT_EQ(early.size(), 2u);
     EXPECT_EQ(early[0].by, Emitted::By::kTilt);
     EXPECT_EQ(early[0].stamp, kT0 + 1'030'000'000);
     EXPECT_EQ(late[0].stamp, kT0 + 1'030'000'000);
     EXPECT_EQ(stats.sweepsClosedOnTilt, 0u);
-    expectSameSweeps(early, late);
   }
 }
