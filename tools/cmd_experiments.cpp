@@ -74,6 +74,11 @@ struct ExperimentOptions {
   int validationPart = -1;  // -1 = the preset's
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
+  int jitter = 0;                                  // jittered copies per positive (training_set.h)
+  std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
+  std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
+  std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to
+  std::vector<int> neighborsSweep;                 // min neighbours of that sweep (default: --min-neighbors)
   std::string commandLine;
 };
 
@@ -287,7 +292,33 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.match = match;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
+  c.samples.jitterCopies = o.jitter;
   return c;
+}
+
+// Stages a class's cascades keep (--class-stages); 0 = every trained stage.
+std::size_t keptStages(const ExperimentOptions& o, const std::string& cls) {
+  const auto it = o.classStages.find(cls);
+  return it == o.classStages.end() ? 0 : it->second;
+}
+
+// "person=5,bike=4" -> {person: 5, bike: 4}.
+std::map<std::string, std::size_t> parseClassStages(const std::vector<std::string>& items) {
+  std::map<std::string, std::size_t> out;
+  for (const std::string& item : items) {
+    const auto eq = item.find('=');
+    std::size_t n = 0;
+    try {
+      if (eq == std::string::npos || eq == 0) throw std::invalid_argument(item);
+      std::size_t used = 0;
+      n = std::stoul(item.substr(eq + 1), &used);
+      if (used != item.size() - eq - 1 || n == 0) throw std::invalid_argument(item);
+    } catch (const std::logic_error&) {
+      throw std::runtime_error("--class-stages: expected CLASS=N with N >= 1 (e.g. person=5), got '" + item + "'");
+    }
+    out[item.substr(0, eq)] = n;
+  }
+  return out;
 }
 
 boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::ExperimentPlan& p, const std::string& cls,
@@ -300,6 +331,7 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
   } else {
     spec.parts = {trainingConfig(o, p, cls, trainedConfig(config), match)};
   }
+  spec.keepStages = keptStages(o, cls);
   return spec;
 }
 
@@ -389,6 +421,7 @@ int runExperiments(ExperimentOptions o) {
   if (o.out.empty()) throw std::runtime_error("--out is required");
   fs::create_directories(o.out);
   const boosting::VanPolicy van = boosting::parseVanPolicy(o.van);
+  o.classStages = parseClassStages(o.classStagesText);
   const boosting::ExperimentPlan preset = planFor(o);
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
@@ -490,7 +523,13 @@ int runExperiments(ExperimentOptions o) {
       {"minimum detection height", o.minHeightFromPositives ? "smallest training positive (model's min_height)"
                                                             : "base window"},
       {"fold model cache", cache.string()},
+      {"jittered copies per positive", std::to_string(o.jitter)},
   };
+  if (!o.classStages.empty()) {
+    std::string kept;
+    for (const auto& [cls, n] : o.classStages) kept += (kept.empty() ? "" : ", ") + cls + " " + std::to_string(n);
+    report.settings["stages kept per class (cut after training; --class-stages)"] = kept;
+  }
 
   boosting::NullProgress quiet;
   const auto log = [](const std::string& line) {
@@ -570,17 +609,22 @@ int runExperiments(ExperimentOptions o) {
       if (!pr.empty())
         cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
                     lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
-      Series lc{"F (all)", {}, {}};
+      Series lc{"F (all)", {}, {}}, lcAp{"AP (all)", {}, {}};
+      const auto addPoint = [](Series& se, std::size_t drives, const Estimate& e) {
+        if (!e.value) return;
+        se.points.push_back({static_cast<double>(drives), *e.value});
+        se.band.push_back(e.interval ? std::make_pair(e.interval->lo, e.interval->hi)
+                                     : std::make_pair(*e.value, *e.value));
+      };
       for (const LearningPoint& p : report.learning)
-        if (p.className == cls && p.f.value) {
-          lc.points.push_back({static_cast<double>(p.drives), *p.f.value});
-          lc.band.push_back(p.f.interval ? std::make_pair(p.f.interval->lo, p.f.interval->hi)
-                                         : std::make_pair(*p.f.value, *p.f.value));
+        if (p.className == cls) {
+          addPoint(lc, p.drives, p.f);
+          addPoint(lcAp, p.drives, p.ap);
         }
       if (!lc.points.empty())
         cv::imwrite((o.out / ("learning_" + cls + ".png")).string(),
-                    lineChart(cls + ": F vs training drives per fold (95% CI)", "training drives", "F",
-                              static_cast<double>(mostDrives), {lc}));
+                    lineChart(cls + ": F and AP vs training drives per fold (95% CI)", "training drives", "F, AP",
+                              static_cast<double>(mostDrives), {lc, lcAp}));
     }
     const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
     for (const ConfigResult& all : report.results) {
@@ -663,6 +707,41 @@ int runExperiments(ExperimentOptions o) {
       runConfig(cls, "all");
       writeSoFar(false);
     }
+  // Stage-count sweep: the `all` fold cascades (now in the cache) cut and regrouped, no training.
+  if (wantAll && !o.stageSweep.empty())
+    for (const std::string& cls : o.classes) {
+      const boosting::MatchConfig match = boosting::matchConfigFor(cls, van);
+      boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
+      const std::vector<int> neighbours = o.neighborsSweep.empty() ? std::vector<int>{o.minNeighbors} : o.neighborsSweep;
+      for (std::size_t stages : o.stageSweep)
+        for (int mn : neighbours) {
+          spec.keepStages = stages;
+          boosting::DetectionSetup s = setup;
+          s.group.minNeighbors = mn;
+          s.scan.threads = o.threads;  // nothing is timed here
+          const boosting::CrossValidationResult cv =
+              boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, s, cache, quiet);
+          SweepPoint p;
+          p.className = cls;
+          p.stages = stages;
+          p.minNeighbors = mn;
+          if (!cv.summaries.empty()) {
+            const boosting::CascadeSummary sum = boosting::combineSummaries(cv.summaries);
+            p.meanStages = static_cast<double>(sum.stages) / static_cast<double>(cv.summaries.size());
+            p.meanLength = static_cast<double>(sum.length) / static_cast<double>(cv.summaries.size());
+          }
+          p.counts = boosting::countsOf(boosting::allFrames(cv.frames));
+          const Measured mm = measure(cv.frames, boot);
+          p.f = mm.f;
+          p.ap = mm.ap;
+          std::printf("%-7s sweep: %2zu stages, min neighbours %d  F %s  AP %s  (%zu hits, %zu false alarms, %zu misses)\n",
+                      cls.c_str(), stages, mn, formatEstimate(p.f).c_str(), formatEstimate(p.ap).c_str(), p.counts.hits,
+                      p.counts.falseAlarms, p.counts.misses);
+          std::fflush(stdout);
+          report.sweep.push_back(p);
+          writeSoFar(false);
+        }
+    }
   for (const std::string& config : configs) {
     if (config == "all") continue;
     for (const std::string& cls : o.classes) {
@@ -712,7 +791,10 @@ int runExperiments(ExperimentOptions o) {
       const std::vector<DatasetItem>& trainItems = trainItemsOf[cls];
       std::vector<std::size_t> every(items.size());
       for (std::size_t i = 0; i < every.size(); ++i) every[i] = i;
-      const boosting::TrainingConfig config = trainingConfig(o, preset, cls, trainedConfig("all"), match);
+      boosting::TrainingConfig config = trainingConfig(o, preset, cls, trainedConfig("all"), match);
+      // The cut the folds were measured with = training with that stage limit (firstStages()).
+      if (const std::size_t kept = keptStages(o, cls); kept > 0)
+        config.maxStages = std::min(config.maxStages, static_cast<int>(kept));
       try {
         boosting::TrainingReport tr;
         const boosting::Cascade c = boosting::trainOrLoad(config, trainItems, every, cache, quiet, &tr);
@@ -862,6 +944,26 @@ const bool registered = registerCommand(
       app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
                    "models store their smallest training positive's height as minimum detection height "
                    "(default: detection scans from the base window)");
+      app.add_option("--jitter", o->jitter,
+                     "jittered copies (shifted and scaled by up to 5 %) of every training positive, besides its "
+                     "mirror image, as `fusedet train --jitter` (default: 0)")
+          ->check(CLI::Range(0, 20))
+          ->capture_default_str();
+      app.add_option("--class-stages", o->classStagesText,
+             "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
+             "stages in every configuration and the learning curve (the same cascades as training with a stage "
+             "limit of N, which --models-out then does); other classes keep every stage")
+          ->delimiter(',');
+      app.add_option("--stage-sweep", o->stageSweep,
+                     "after each class's `all` configuration, evaluate its fold cascades cut to each of these "
+                     "stage counts, e.g. 1,2,3,4,6,8,14 (no retraining; report section \"Stage count and grouping "
+                     "sweep\")")
+          ->delimiter(',')
+          ->check(CLI::PositiveNumber);
+      app.add_option("--neighbors-sweep", o->neighborsSweep,
+                     "min neighbours the stage sweep groups with, e.g. 1,2,3 (default: --min-neighbors)")
+          ->delimiter(',')
+          ->check(CLI::Range(0, 1000));
       app.add_option("--min-positives", o->minPositives,
                      "training ends when fewer positives than this are still accepted (person data is scarce)")
           ->capture_default_str();

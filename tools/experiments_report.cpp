@@ -238,6 +238,27 @@ std::string renderMarkdown(const ExperimentReport& r) {
     md << "\n";
   }
 
+  if (!r.sweep.empty()) {
+    md << "## Stage count and grouping sweep\n\n"
+          "Configuration `all` per class: every fold's trained cascade cut to its first N stages (the cascade "
+          "training with a stage limit of N gives: stages are trained in order with per-stage seeds) and its "
+          "hits grouped with the given minimum of neighbours; pooled over folds. Every row is measured on the "
+          "same held-out frames, so picking the best row here is a choice made on the test frames: choose on "
+          "one fold design and confirm on another.\n\n";
+    std::vector<std::vector<std::string>> body;
+    for (const SweepPoint& p : r.sweep) {
+      char stages[64];
+      std::snprintf(stages, sizeof stages, "%.1f / %.1f", p.meanStages, p.meanLength);
+      body.push_back({p.className, std::to_string(p.stages), std::to_string(p.minNeighbors), stages,
+                      formatEstimate(p.f), formatEstimate(p.ap),
+                      std::to_string(p.counts.hits) + " / " + std::to_string(p.counts.falseAlarms) + " / " +
+                          std::to_string(p.counts.misses)});
+    }
+    table(md, {"class", "stages kept (at most)", "min neighbours", "mean stages / stumps", "F [95 % CI]", "AP [95 % CI]",
+               "hits / false alarms / misses"},
+          body);
+  }
+
   const auto weightShares = [&](const std::string& config, const std::string& heading) {
     std::vector<const ConfigResult*> results;
     std::map<std::string, double> allLayers;
@@ -361,6 +382,13 @@ json toJson(const ExperimentReport& r) {
     j["learning_curve"].push_back({{"class", p.className}, {"drives", p.drives}, {"f_measure", estimateJson(p.f)},
                                    {"average_precision", estimateJson(p.ap)}, {"hits", p.counts.hits},
                                    {"false_alarms", p.counts.falseAlarms}, {"misses", p.counts.misses}});
+  j["stage_sweep"] = json::array();
+  for (const SweepPoint& p : r.sweep)
+    j["stage_sweep"].push_back({{"class", p.className}, {"stages", p.stages}, {"min_neighbors", p.minNeighbors},
+                                {"mean_stages", p.meanStages}, {"mean_stumps", p.meanLength},
+                                {"f_measure", estimateJson(p.f)}, {"average_precision", estimateJson(p.ap)},
+                                {"hits", p.counts.hits}, {"false_alarms", p.counts.falseAlarms},
+                                {"misses", p.counts.misses}});
   j["goals"] = json::array();
   for (const Goal& g : r.goals)
     j["goals"].push_back({{"class", g.className}, {"goal", g.text}, {"target", g.target},

@@ -62,6 +62,17 @@ struct LearningPoint {
   Estimate f, ap;
 };
 
+// One point of a stage-count sweep: a class's `all` fold cascades cut to their first `stages`
+// stages (boosting::firstStages, no retraining) and grouped with `minNeighbors`.
+struct SweepPoint {
+  std::string className;
+  std::size_t stages = 0;
+  int minNeighbors = 0;
+  double meanStages = 0, meanLength = 0;  // what the cut fold cascades really have
+  boosting::Counts counts;
+  Estimate f, ap;
+};
+
 struct ClassCounts {
   std::string className;
   std::size_t positives = 0, ignoredLabels = 0, frames = 0, drivesWithPositives = 0;
@@ -86,6 +97,7 @@ struct ExperimentReport {
   std::vector<Claim> claims;
   std::vector<LearningPoint> learning;
   std::string learningFolds;  // the learning curve's fold design, e.g. "3 drive-disjoint folds"
+  std::vector<SweepPoint> sweep;
   std::vector<Goal> goals;
   std::map<std::string, std::string> settings;  // shown in a table and in results.json
   std::vector<std::string> notes;               // facts the run wants the reader to know

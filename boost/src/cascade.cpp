@@ -14,6 +14,13 @@ std::size_t Cascade::weakCount() const {
 
 bool Cascade::hasTrees() const { return !treeStages.empty(); }
 
+Cascade firstStages(Cascade cascade, std::size_t stages) {
+  if (stages == 0) throw std::invalid_argument("firstStages: a cascade keeps at least one stage");
+  if (cascade.stages.size() > stages) cascade.stages.resize(stages);
+  if (cascade.treeStages.size() > stages) cascade.treeStages.resize(stages);
+  return cascade;
+}
+
 int Cascade::addFeature(const Feature& f) {
   features.push_back(f);
   return static_cast<int>(features.size()) - 1;

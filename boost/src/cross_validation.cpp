@@ -133,6 +133,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
         out.trainSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out.cachedFolds += cached ? 1 : 0;
         out.cachedTrainSeconds += cached ? recorded : 0;
+        if (spec.keepStages > 0) c = firstStages(std::move(c), spec.keepStages);
         parts.push_back(summarizeCascade(c));
         detectors.emplace_back(std::move(c));
       }

@@ -124,6 +124,27 @@ TEST(CascadeTrainer, SameSeedSameDataGivesByteIdenticalModelForAnyThreadCount) {
   EXPECT_NE(modelToText(trainCascade(c, items, quiet), {{"seed", "5"}}), one);
 }
 
+// A stage-count sweep cuts trained cascades instead of training again (cross_validation.h
+// ChainSpec::keepStages): that is only honest if the cut equals the cascade trained with that limit.
+TEST(CascadeTrainer, FirstStagesOfALongerCascadeEqualTrainingWithThatStageLimit) {
+  const auto items = scenes(12, true);
+  TrainingConfig c = smallConfig();
+  c.pool.layers = {"intensity", "hue_distance"};
+  c.targetFalseAlarm = 1e-9;  // not the target: the stage limit (or the negatives) ends the trainings
+  c.maxStages = 3;
+  NullProgress quiet;
+  const Cascade three = trainCascade(c, items, quiet);
+  ASSERT_GE(three.stages.size(), 2u);  // (these scenes run out of negatives after two)
+  for (int limit = 1; limit <= static_cast<int>(three.stages.size()); ++limit) {
+    c.maxStages = limit;
+    const Cascade trained = trainCascade(c, items, quiet);
+    ASSERT_EQ(trained.stages.size(), static_cast<std::size_t>(limit));
+    EXPECT_EQ(modelToText(firstStages(three, static_cast<std::size_t>(limit))), modelToText(trained)) << limit;
+  }
+  EXPECT_EQ(firstStages(three, 7).stages.size(), three.stages.size());  // fewer than asked: all of them
+  EXPECT_THROW(firstStages(three, 0), std::invalid_argument);
+}
+
 TEST(CascadeTrainer, ClearErrorsForNoPositivesAndMissingLayers) {
   auto items = scenes(4, false);
   TrainingConfig c = smallConfig();

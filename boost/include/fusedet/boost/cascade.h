@@ -105,4 +105,10 @@ struct Cascade {
   void validate() const;
 };
 
+// The cascade's first `stages` stages (all of them when it has no more). Training adds stages in
+// order, each from the cascade before it with its own per-stage seed (cascade_trainer.h), so this
+// is the cascade training with max_stages = `stages` gives: a stage-count sweep can cut trained
+// models instead of training again. Throws std::invalid_argument for 0.
+Cascade firstStages(Cascade cascade, std::size_t stages);
+
 }  // namespace fusedet::boosting

@@ -54,6 +54,9 @@ struct CrossValidationResult {
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
 struct ChainSpec {
   std::vector<TrainingConfig> parts;
+  // > 0: each part is evaluated cut to its first `keepStages` stages (firstStages(): the cascade
+  // training with that stage limit gives), so one trained (cached) model serves every stage count.
+  std::size_t keepStages = 0;
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
