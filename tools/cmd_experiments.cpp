@@ -75,6 +75,7 @@ struct ExperimentOptions {
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
+  double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
   std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to
@@ -276,6 +277,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.samples.scan.scaleFactor = p.trainScaleFactor;
   c.samples.scan.step = p.trainStep;
   c.stage.maxWeak = p.maxWeak;
+  c.stage.maxFalseAlarm = o.stageMaxFalseAlarm;
   c.stage.threads = o.threads;
   c.targetFalseAlarm = p.targetFalseAlarm;
   c.maxStages = p.maxStages;
@@ -422,6 +424,9 @@ int runExperiments(ExperimentOptions o) {
   fs::create_directories(o.out);
   const boosting::VanPolicy van = boosting::parseVanPolicy(o.van);
   o.classStages = parseClassStages(o.classStagesText);
+  for (const auto& [cls, n] : o.classStages)
+    if (std::find(o.classes.begin(), o.classes.end(), cls) == o.classes.end())
+      throw std::runtime_error("--class-stages: class '" + cls + "' is not among --classes (" + joined(o.classes) + ")");
   const boosting::ExperimentPlan preset = planFor(o);
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
@@ -504,7 +509,7 @@ int runExperiments(ExperimentOptions o) {
       {"max stumps per stage", std::to_string(preset.maxWeak)},
       {"target false-alarm rate", shortNum(preset.targetFalseAlarm)},
       {"negatives per stage", preset.negatives ? std::to_string(preset.negatives) : "max(500, 2 x positives)"},
-      {"stage min hit / max false alarm", "0.995 / 0.5"},
+      {"stage min hit / max false alarm", "0.995 / " + shortNum(o.stageMaxFalseAlarm)},
       {"validation part", preset.validationPart
                               ? "1/" + std::to_string(preset.validationPart) +
                                     " of each fold's training frames (whole drives, smallest first): stage " +
@@ -944,6 +949,11 @@ const bool registered = registerCommand(
       app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
                    "models store their smallest training positive's height as minimum detection height "
                    "(default: detection scans from the base window)");
+      app.add_option("--max-fa", o->stageMaxFalseAlarm,
+                     "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
+                     "longer stages whose sums average more stumps")
+          ->check(CLI::Range(1e-6, 0.99))
+          ->capture_default_str();
       app.add_option("--jitter", o->jitter,
                      "jittered copies (shifted and scaled by up to 5 %) of every training positive, besides its "
                      "mirror image, as `fusedet train --jitter` (default: 0)")

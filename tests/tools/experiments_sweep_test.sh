@@ -26,4 +26,7 @@ rc=0
 "$fusedet" experiments --data "$data" --out "$work/bad" --class-stages person >"$work/bad.txt" 2>&1 || rc=$?
 [ "$rc" -eq 1 ] || { cat "$work/bad.txt" >&2; fail "--class-stages person: exit status $rc, expected 1 (an error, no crash)"; }
 grep -q 'expected CLASS=N with N >= 1' "$work/bad.txt" || { cat "$work/bad.txt" >&2; fail "unclear --class-stages error"; }
+rc=0
+"$fusedet" experiments --data "$data" --out "$work/bad" --classes car --class-stages bike=3 >"$work/bad.txt" 2>&1 || rc=$?
+[ "$rc" -eq 1 ] && grep -q "class 'bike' is not among --classes" "$work/bad.txt" || { cat "$work/bad.txt" >&2; fail "--class-stages for a class not run"; }
 echo "ok"
