@@ -185,7 +185,22 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
     for (std::size_t i = 0; i < jobs.size(); ++i) run(i);
     return;
   }
-  auto all = [&] { tbb::parallel_for(std::size_t(0), jobs.size(), run); };
+  // Largest jobs first, one task each (hue_distance slots derive their values too; double tables
+  // write twice the bytes), so that no big slot is left alone at the end while the other thread
+  // idles. Each slot is written by one job, so the order changes no value.
+  auto cost = [&](std::size_t i) {
+    const Source& src = jobs[i].source;
+    const double pixels = double(src.data.cols) * double(src.data.rows);
+    const bool exactInt = grids_[static_cast<std::size_t>(jobs[i].ref.grid)].exactInt;
+    return pixels * (exactInt ? 1.0 : 2.0) * (src.hueReference ? 2.0 : 1.0);
+  };
+  std::vector<std::size_t> order(jobs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
+  auto all = [&] {
+    tbb::parallel_for(
+        std::size_t(0), order.size(), [&](std::size_t k) { run(order[k]); }, tbb::simple_partitioner());
+  };
   if (threads > 1) {
     tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
     arena.execute(all);

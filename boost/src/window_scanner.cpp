@@ -31,11 +31,16 @@ int roundHalfUp(double v) { return static_cast<int>(std::floor(v + 0.5)); }
 // One stump laid out for one scale: its rectangles' corners as offsets from the window's origin in
 // its grid, (x0,y0) (x1,y0) (x0,y1) (x1,y1). black = rect 0 (+ rect 1 for the checker); white =
 // rect 2, minus black when rect 2 is the outer rectangle (FeatureLayout's rule).
+// Two-rectangle features whose halves share an edge (types a and b): the white rectangle's two
+// corners on that edge are the black one's, loaded once by the vector paths.
+enum class SharedEdge : std::uint8_t { kNone, kColumn /* white's left = black's right */, kRow /* white's top = black's bottom */ };
+
 struct GridStump {
   int grid = 0;
   bool intGrid = false;  // the grid's tables are int32 (IntegralGrid::exactInt)
   bool checker = false;
   bool whiteIsRest = false;
+  SharedEdge shared = SharedEdge::kNone;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
   // The vector paths' quick form (stumps on layers that are not contrast-normalised): value' =
@@ -70,6 +75,8 @@ struct GridContrast {
   double area = 1;
 };
 
+constexpr int kSpanStride = 3;
+
 struct GridStage {
   std::uint32_t begin = 0, end = 0;
   double threshold = 0;
@@ -79,7 +86,9 @@ struct GridScale {
   ScaleWindows win;
   std::vector<std::vector<std::int32_t>> colOfs, rowOfs;  // per grid, per position
   // Per grid: 1 or 2 when neighbouring windows' origins are that many values apart along the whole
-  // row (plain or every-other vector loads replace gathers in stage 0), else 0.
+  // row (plain or every-other vector loads replace gathers in stage 0); kSpanStride when any eight
+  // neighbours' origins lie within 16 values of the first one's (two loads and a lane permutation
+  // replace a gather with eight lanes; the four-lane path gathers), else 0.
   std::vector<int> colStride;
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
@@ -114,6 +123,11 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       bool regular = true;
       for (std::size_t i = 1; i < co.size() && regular; ++i) regular = co[i] - co[i - 1] == d;
       if (regular && co.size() > 1) sp.colStride.back() = d;
+    }
+    if (sp.colStride.back() == 0) {  // offsets grow with the column: a window's span is its eighth's
+      bool narrow = true;
+      for (std::size_t i = 0; i < co.size() && narrow; ++i) narrow = co[std::min(i + 7, co.size() - 1)] - co[i] <= 15;
+      if (narrow) sp.colStride.back() = kSpanStride;
     }
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
     for (int y : win.ys)
@@ -164,6 +178,10 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       z.ofs[0] = corners(lay.rects[0]);
       if (z.checker) z.ofs[1] = corners(lay.rects[1]);
       z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
+      if (!z.checker && !z.whiteIsRest) {
+        if (z.ofs[2][0] == z.ofs[0][1] && z.ofs[2][2] == z.ofs[0][3]) z.shared = SharedEdge::kColumn;
+        if (z.ofs[2][0] == z.ofs[0][2] && z.ofs[2][1] == z.ofs[0][3]) z.shared = SharedEdge::kRow;
+      }
       z.blackArea = lay.blackArea;
       z.whiteArea = lay.whiteArea;
       z.invBlackArea = 1.0 / lay.blackArea;
@@ -410,11 +428,15 @@ struct Lanes {
   }
   static Ints compress(Ints v, int keep) { return _mm256_maskz_compress_epi32(static_cast<__mmask8>(keep), v); }
   static Doubles compress(Doubles v, int keep) { return _mm512_maskz_compress_pd(static_cast<__mmask8>(keep), v); }
-  static Doubles corners(const double* b, Ints o, int stride) {  // as avx2::Lanes::corners
+  // As avx2::Lanes::corners; kSpanStride: the eight values lie within 16 of b (o = offsets from b),
+  // picked from two loads by a permutation instead of gathered.
+  static Doubles corners(const double* b, Ints o, int stride) {
     if (stride == 1) return _mm512_loadu_pd(b);
     if (stride == 2)
       return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14),
                                     _mm512_loadu_pd(b + 8));
+    if (stride == kSpanStride)
+      return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_cvtepi32_epi64(o), _mm512_loadu_pd(b + 8));
     return _mm512_i32gather_pd(o, b, 8);
   }
   static Ints corners(const std::int32_t* b, Ints o, int stride) {
@@ -424,6 +446,8 @@ struct Lanes {
       return _mm512_castsi512_si256(
           _mm512_permutexvar_epi32(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), v));
     }
+    if (stride == kSpanStride)
+      return _mm512_castsi512_si256(_mm512_permutexvar_epi32(_mm512_castsi256_si512(o), _mm512_loadu_si512(b)));
     return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), b, o, _mm256_set1_epi32(-1), 4);
   }
   static Doubles toDouble(Doubles v) { return v; }
@@ -479,6 +503,18 @@ std::size_t firstStageScalar(const GridScale& sp, const void* const* grids, std:
     }
   l.pad(n);
   return stageScalar(sp, sp.stages.front(), grids, l, n);
+}
+
+// Runs `work` (parallel loops inside) on ScanParams::threads threads: an arena of that many (> 1),
+// or with 0 the calling thread's own arena (all cores).
+template <class Work>
+void onThreads(int threads, Work&& work) {
+  if (threads > 1) {
+    tbb::task_arena arena(std::min(threads, tbb::info::default_concurrency()));
+    arena.execute(work);
+  } else {
+    work();
+  }
 }
 
 constexpr std::size_t kBand = 48;  // window columns per tile
@@ -581,19 +617,33 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
     if (static_cast<double>(g.pitch) * (g.height + 1) >= 2147483647.0)
       throw std::invalid_argument("scan: layers too large for 32-bit offsets (" + std::to_string(g.width) + "x" +
                                   std::to_string(g.height) + " x " + std::to_string(g.slots.size()) + " layers)");
+  // Plans of every cascade and scale, made by the threads too (the serial part of a scan is what
+  // the second core cannot shorten).
   std::vector<std::vector<GridScale>> plans(nc);
+  std::vector<std::vector<SlotRef>> slots(nc), sqSlots(nc);
+  std::vector<std::pair<std::size_t, std::size_t>> planJobs;
   for (std::size_t c = 0; c < nc; ++c) {
     const Cascade& cc = *cascades[c];
     if (cc.isOpenCv()) throw std::invalid_argument("scanCascades: OpenCV models scan their own pyramid");
-    std::vector<SlotRef> slots, sqSlots;
     for (std::size_t l = 0; l < cc.layers.size(); ++l) {
       const std::string& name = cc.layers[l];
       const std::optional<double> hue = name == layer::kHueDistance ? cc.referenceHue : std::nullopt;
-      slots.push_back(in.find(LayerRequest{name, hue, false}));
-      sqSlots.push_back(cc.isContrastNormalised(l) ? in.find(LayerRequest{name, hue, true}) : SlotRef{});
+      slots[c].push_back(in.find(LayerRequest{name, hue, false}));
+      sqSlots[c].push_back(cc.isContrastNormalised(l) ? in.find(LayerRequest{name, hue, true}) : SlotRef{});
     }
-    for (ScaleWindows& w : windowScales(cc, in.refWidth(), in.refHeight(), params))
-      plans[c].push_back(planScale(cc, in, slots, sqSlots, std::move(w)));
+    for (ScaleWindows& w : windowScales(cc, in.refWidth(), in.refHeight(), params)) {
+      planJobs.emplace_back(c, plans[c].size());
+      plans[c].emplace_back().win = std::move(w);
+    }
+  }
+  auto plan = [&](std::size_t j) {
+    const auto [c, s] = planJobs[j];
+    plans[c][s] = planScale(*cascades[c], in, slots[c], sqSlots[c], std::move(plans[c][s].win));
+  };
+  if (params.threads == 1) {
+    for (std::size_t j = 0; j < planJobs.size(); ++j) plan(j);
+  } else {
+    onThreads(params.threads, [&] { tbb::parallel_for(std::size_t(0), planJobs.size(), plan); });
   }
   // Work items: tiles of one scale of one cascade (a band of window columns, a few rows), all in
   // one index space so that threads share the work across cascades and scales. Ordered by scale,
@@ -631,18 +681,12 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
     WindowList l;
     for (std::size_t i = 0; i < items.size(); ++i) runItem(i, l);
   } else {
-    auto run = [&] {
+    onThreads(params.threads, [&] {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size()), [&](const tbb::blocked_range<std::size_t>& r) {
         WindowList l;
         for (std::size_t i = r.begin(); i != r.end(); ++i) runItem(i, l);
       });
-    };
-    if (params.threads > 1) {
-      tbb::task_arena arena(std::min(params.threads, tbb::info::default_concurrency()));
-      arena.execute(run);
-    } else {
-      run();
-    }
+    });
   }
   std::vector<std::vector<RawHit>> out(nc);
   for (std::size_t i = 0; i < items.size(); ++i)
