@@ -588,7 +588,10 @@ int runExperiments(ExperimentOptions o) {
 
   // Claims, goals and charts from what is measured so far; the report is rewritten after every
   // step, so a run stopped early still leaves a report of what it finished (marked partial).
+  std::map<std::string, boosting::FoldModel> foldModels;  // every fold model the run used, as first used
   const auto writeSoFar = [&](bool finished) {
+    report.cachedTrainSeconds = 0;
+    for (const auto& [key, m] : foldModels) report.cachedTrainSeconds += m.cached ? m.trainSeconds : 0;
     report.claims.clear();
     report.goals.clear();
     for (const std::string& cls : o.classes) {
@@ -677,7 +680,7 @@ int runExperiments(ExperimentOptions o) {
     r.trainSeconds = cv.trainSeconds;
     r.cachedTrainSeconds = cv.cachedTrainSeconds;
     report.trainSeconds += cv.trainSeconds;
-    report.cachedTrainSeconds += cv.cachedTrainSeconds;
+    foldModels.insert(cv.models.begin(), cv.models.end());
     r.folds = folds.size();
     r.cachedFolds = cv.cachedFolds;
     r.failures = cv.failures;
@@ -774,7 +777,7 @@ int runExperiments(ExperimentOptions o) {
           const boosting::CrossValidationResult cv =
               boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log);
           report.trainSeconds += cv.trainSeconds;
-          report.cachedTrainSeconds += cv.cachedTrainSeconds;
+          foldModels.insert(cv.models.begin(), cv.models.end());
           frames = cv.frames;
         }
         p.counts = boosting::countsOf(boosting::allFrames(frames));

@@ -103,8 +103,8 @@ struct ExperimentReport {
   std::vector<std::string> notes;               // facts the run wants the reader to know
   double totalSeconds = 0;
   // Training of every fold cascade the run used: done in this run, and recorded in the model
-  // files of the cached ones (their training when they were made) - together the run's cost
-  // without a cache.
+  // files of the cached ones (their training when they were made; each model once, also when
+  // several configurations use it) - together the run's training without a cache.
   double trainSeconds = 0, cachedTrainSeconds = 0;
   double loadAverage = -1;  // 1-minute load average at the end (shared machine), < 0 unknown
 };

@@ -69,8 +69,7 @@ std::string trainingKey(const TrainingConfig& config, const std::vector<std::str
 
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
-                    ProgressSink& progress, TrainingReport* report, bool* fromCache,
-                    double* cachedTrainSeconds) {
+                    ProgressSink& progress, TrainingReport* report, bool* fromCache, FoldModel* source) {
   std::vector<DatasetItem> subset;
   std::vector<std::string> ids;
   subset.reserve(train.size());
@@ -83,16 +82,17 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
   if (!file.empty() && std::filesystem::exists(file)) {
     if (fromCache) *fromCache = true;
     Cascade cached = loadModel(file);
-    if (cachedTrainSeconds) {
-      *cachedTrainSeconds = 0;
+    if (source) {
+      *source = FoldModel{key, true, 0};
       for (const auto& [k, v] : loadModelInfo(file))
-        if (k == "train_seconds") *cachedTrainSeconds = std::strtod(v.c_str(), nullptr);
+        if (k == "train_seconds") source->trainSeconds = std::strtod(v.c_str(), nullptr);
     }
     return cached;
   }
   if (fromCache) *fromCache = false;
   TrainingReport local;
   Cascade cascade = trainCascade(config, subset, progress, report ? report : &local);
+  if (source) *source = FoldModel{key, false, (report ? *report : local).seconds};
   if (!file.empty()) {
     std::filesystem::create_directories(cacheDir);
     const TrainingReport& r = report ? *report : local;
@@ -126,13 +126,14 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     try {
       for (const TrainingConfig& part : spec.parts) {
         bool cached = false;
-        double recorded = 0;
+        FoldModel source;
         TrainingReport report;
         const auto t0 = std::chrono::steady_clock::now();
-        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached, &recorded);
+        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached, &source);
         out.trainSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out.cachedFolds += cached ? 1 : 0;
-        out.cachedTrainSeconds += cached ? recorded : 0;
+        out.cachedTrainSeconds += cached ? source.trainSeconds : 0;
+        out.models.emplace(source.key, source);
         if (spec.keepStages > 0) c = firstStages(std::move(c), spec.keepStages);
         parts.push_back(summarizeCascade(c));
         detectors.emplace_back(std::move(c));

@@ -8,8 +8,10 @@
 #include <fstream>
 #include <sstream>
 #include <random>
+#include <unistd.h>
 
 #include "fusedet/boost/class_rules.h"
+#include "fusedet/boost/cross_validation.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/validation_part.h"
 #include "fusedet/boost/model_io.h"
@@ -477,4 +479,39 @@ TEST(CascadeTrainer, ContrastNormalisedTrainingIsRecordedAndSurvivesAGainChange)
   // A layer that is not in the pool is refused.
   config.pool.contrastNormalised = {"distance"};
   EXPECT_THROW(trainCascade(config, items, quiet), std::invalid_argument);
+}
+
+// The fold-model cache: the first call trains and writes the model under its key, the second
+// loads it and reports the training time the file recorded (what a run from the cache would have
+// cost without it), not the time of loading.
+TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
+  const auto items = scenes(8, true);
+  TrainingConfig c = smallConfig();
+  c.pool.layers = {"intensity", "hue_distance"};
+  c.maxStages = 2;
+  c.threads = 1;
+  const std::vector<std::size_t> train = {0, 1, 2, 3, 4, 5, 6, 7};
+  const auto dir = std::filesystem::temp_directory_path() / ("fusedet_fold_cache_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  NullProgress quiet;
+  bool cached = true;
+  FoldModel first, second;
+  TrainingReport report;
+  const Cascade trained = trainOrLoad(c, items, train, dir, quiet, &report, &cached, &first);
+  EXPECT_FALSE(cached);
+  EXPECT_FALSE(first.cached);
+  EXPECT_EQ(first.key.size(), 16u);
+  EXPECT_DOUBLE_EQ(first.trainSeconds, report.seconds);
+  ASSERT_TRUE(std::filesystem::exists(dir / (first.key + ".json")));
+  double recorded = -1;
+  for (const auto& [k, v] : loadModelInfo(dir / (first.key + ".json")))
+    if (k == "train_seconds") recorded = std::stod(v);
+  ASSERT_GE(recorded, 0);
+  const Cascade loaded = trainOrLoad(c, items, train, dir, quiet, nullptr, &cached, &second);
+  EXPECT_TRUE(cached);
+  EXPECT_TRUE(second.cached);
+  EXPECT_EQ(second.key, first.key);
+  EXPECT_DOUBLE_EQ(second.trainSeconds, recorded);
+  EXPECT_EQ(modelToText(loaded), modelToText(trained));
+  std::filesystem::remove_all(dir);
 }

@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,15 +30,22 @@ std::string describeTrainingConfig(const TrainingConfig& config);
 // 16 hex digits: FNV-1a 64 of the description and the training item ids, in order.
 std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds);
 
+// Where trainOrLoad()'s model came from: its cache key, whether it was loaded from the cache, and
+// its training time - measured now, or as its file records it (0 if none), so a run from the
+// cache can still say what it would cost without one.
+struct FoldModel {
+  std::string key;
+  bool cached = false;
+  double trainSeconds = 0;
+};
+
 // Trains on items[train] (or loads `cacheDir/<key>.json` when it exists; empty cacheDir = no
-// cache) and writes the model there. `fromCache` tells which; for a cached model
-// `cachedTrainSeconds` gets the training time its file records (0 if none), so a run from the
-// cache can still say what it would cost without one. Throws what trainCascade throws (e.g. too
-// few positives).
+// cache) and writes the model there. `fromCache` tells which; `source` gets the details. Throws
+// what trainCascade throws (e.g. too few positives).
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
                     ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr,
-                    double* cachedTrainSeconds = nullptr);
+                    FoldModel* source = nullptr);
 
 // Outcome of one configuration over all folds.
 struct CrossValidationResult {
@@ -49,6 +57,10 @@ struct CrossValidationResult {
   double trainSeconds = 0, msPerStack = 0;          // summed training; mean detection time
   std::size_t cachedFolds = 0;
   double cachedTrainSeconds = 0;  // training time the cached folds' model files record, summed
+  // Every fold model by key, as first used: configurations sharing a model (the AND and its
+  // parts) count it once when a run sums these, and a model trained earlier in the same run is
+  // not counted again as cached.
+  std::map<std::string, FoldModel> models;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
