@@ -29,7 +29,6 @@
 #include <cstdlib>
 #include <cstdint>
 #include <cstring>
-#include <ctime>
 #include <fstream>
 #include <random>
 #include <stdexcept>
@@ -37,6 +36,7 @@
 #include <vector>
 
 #include "fusedet/boost/feature_matrix.h"
+#include "fusedet/core/cpu_time.h"
 #include "fusedet/boost/stump.h"
 #include "boost_round_data.h"
 
@@ -47,11 +47,7 @@ double since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 // CPU seconds of every thread of the process: the work done, whatever else runs on the machine.
-double processCpu() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
-}
+double processCpu() { return fusedet::processCpuMs() / 1000.0; }
 
 // Process CPU and wall seconds of one call.
 struct CpuWall {

@@ -11,11 +11,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <iterator>
 #include <random>
 #include <sstream>
 
+#include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/calib_kitti.h"
 #include "fusedet/fusion/calib_targetless.h"
 #include "fusedet/fusion/score_profile.h"
@@ -24,11 +24,7 @@ namespace {
 
 using namespace fusedet::fusion;
 
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+double cpuSeconds() { return fusedet::processCpuMs() / 1000.0; }
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
