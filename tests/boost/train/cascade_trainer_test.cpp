@@ -369,18 +369,35 @@ TEST(CascadeTrainer, JitteredPositivesStayNearTheirLabel) {
   EXPECT_EQ(k.front().x, j.front().x);  // seeded: the same copies
 }
 
-TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
-  // Two layers at different resolutions; windows of repeated and distinct sizes.
+// Three scenes with two layers at different resolutions: intensity and a half-size "distance"
+// made from it by a gain and offset.
+static std::vector<DatasetItem> twoLayerScenes(unsigned firstSeed) {
   std::vector<DatasetItem> items;
   for (unsigned s = 0; s < 3; ++s) {
-    DatasetItem it = scene(300 + s, 2, false);
-    cv::Mat half;
+    DatasetItem it = scene(firstSeed + s, 2, false);
+    cv::Mat half, f;
     cv::resize(it.stack.at("intensity").data, half, cv::Size(100, 60));
-    cv::Mat f;
     half.convertTo(f, CV_32F, 0.37, -3.1);
     it.stack.set(Layer{"distance", f, {}});
     items.push_back(it);
   }
+  return items;
+}
+
+// The stacks' positives plus 40 random windows of repeated and distinct sizes.
+static std::vector<Sample> positivesAndRandomWindows(const TrainingStacks& stacks, unsigned seed) {
+  std::vector<Sample> samples = stacks.positives();
+  std::mt19937 rng(seed);
+  for (int k = 0; k < 40; ++k) {
+    const double w = 20 + double(rng() % 4) * 7.3, h = w * 0.6;
+    samples.push_back(Sample{std::uint32_t(rng() % stacks.size()),
+                             Box{double(rng() % 150), double(rng() % 80), w, h}});
+  }
+  return samples;
+}
+
+TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
+  const auto items = twoLayerScenes(300);
   SampleConfig sc;
   sc.minPositiveHeight = 20;
   const TrainingStacks stacks(items, {"intensity", "distance"}, std::nullopt, sc);
@@ -388,13 +405,7 @@ TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
   pc.grid = 7;
   pc.layers = {"intensity", "distance"};
   const auto pool = generatePool(pc);
-  std::vector<Sample> samples = stacks.positives();
-  std::mt19937 rng(3);
-  for (int k = 0; k < 40; ++k) {
-    const double w = 20 + double(rng() % 4) * 7.3, h = w * 0.6;
-    samples.push_back(Sample{std::uint32_t(rng() % stacks.size()),
-                             Box{double(rng() % 150), double(rng() % 80), w, h}});
-  }
+  const std::vector<Sample> samples = positivesAndRandomWindows(stacks, 3);
   const SampleFeatures sf(stacks, pool, samples);
   const std::size_t first = 13, count = pool.size() - 20, n = samples.size();
   std::vector<float> out(count * n);
@@ -414,15 +425,7 @@ TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
 // Contrast-normalised layers: the sample path equals featureValue() on them too (the trainer's
 // values are those detection computes).
 TEST(SampleFeatures, EqualsFeatureValueBitForBitOnContrastNormalisedLayers) {
-  std::vector<DatasetItem> items;
-  for (unsigned s = 0; s < 3; ++s) {
-    DatasetItem it = scene(310 + s, 2, false);
-    cv::Mat half, f;
-    cv::resize(it.stack.at("intensity").data, half, cv::Size(100, 60));
-    half.convertTo(f, CV_32F, 0.37, -3.1);
-    it.stack.set(Layer{"distance", f, {}});
-    items.push_back(it);
-  }
+  const auto items = twoLayerScenes(310);
   SampleConfig sc;
   sc.minPositiveHeight = 20;
   for (const std::vector<bool>& flags : {std::vector<bool>{true, false}, std::vector<bool>{true, true}}) {
@@ -432,12 +435,7 @@ TEST(SampleFeatures, EqualsFeatureValueBitForBitOnContrastNormalisedLayers) {
     pc.grid = 6;
     pc.layers = {"intensity", "distance"};
     const auto pool = generatePool(pc);
-    std::vector<Sample> samples = stacks.positives();
-    std::mt19937 rng(4);
-    for (int k = 0; k < 40; ++k) {
-      const double w = 20 + double(rng() % 4) * 7.3, h = w * 0.6;
-      samples.push_back(Sample{std::uint32_t(rng() % stacks.size()), Box{double(rng() % 150), double(rng() % 80), w, h}});
-    }
+    const std::vector<Sample> samples = positivesAndRandomWindows(stacks, 4);
     const SampleFeatures sf(stacks, pool, samples);
     const std::size_t n = samples.size();
     std::vector<float> out(pool.size() * n);
