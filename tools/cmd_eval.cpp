@@ -28,7 +28,7 @@ struct EvalOptions {
   std::string split = "test";
   double trainFraction = 2.0 / 3.0;
   bool json = false;
-  double minIou = 0.5, minHeight = 25, maxTruncation = 0.3;
+  double minIou = 0, minHeight = 25, maxTruncation = 0.3;
   int maxOcclusion = 1;
   std::string van = "ignore";
   double scaleFactor = 1.1, step = 2;
@@ -78,7 +78,7 @@ int runEval(const EvalOptions& o) {
   for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(o.data, e.id, layers));
 
   boosting::MatchConfig match = boosting::matchConfigFor(cls, boosting::parseVanPolicy(o.van));
-  match.minIou = o.minIou;
+  if (o.minIou > 0) match.minIou = o.minIou;
   match.minHeight = o.minHeight;
   match.maxOcclusion = o.maxOcclusion;
   match.maxTruncation = o.maxTruncation;
@@ -170,8 +170,10 @@ const bool registered = registerCommand(
       app.add_flag("--json", o->json,
                    "print one JSON object (recall, precision, f_measure, length, stages, layer_weight_share, "
                    "layer_stump_count, corner_share, ms_per_stack, counts) instead of markdown");
-      app.add_option("--min-iou", o->minIou, "a detection hits a label at IoU >= this")
-          ->check(CLI::Range(0.01, 1.0))
+      app.add_option("--min-iou", o->minIou,
+                     "a detection hits a label at IoU >= this; 0 = the KITTI devkit's minimum overlap of the class "
+                     "(car 0.7, person and bike 0.5)")
+          ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       app.add_option("--min-height", o->minHeight, "labels lower than this [px] are ignored (KITTI moderate: 25)")
           ->capture_default_str();

@@ -20,9 +20,12 @@ std::string toString(VanPolicy policy) {
   return "?";
 }
 
+double kittiMinOverlap(const std::string& className) { return className == "car" ? 0.7 : 0.5; }
+
 MatchConfig matchConfigFor(const std::string& className, VanPolicy van) {
   MatchConfig c;
   c.className = className;
+  c.minIou = kittiMinOverlap(className);
   if (className == "car" && van == VanPolicy::kIgnore) c.neighbourClasses = {"van", "Van"};
   if (className == "car" && van == VanPolicy::kPositive) c.aliasClasses = {"van"};
   if (className == "person") c.neighbourClasses = {"Person_sitting"};

@@ -63,6 +63,30 @@ TEST(KittiRules, TruckTramMiscAreFalseAlarmsDontCareAbsorbs) {
   EXPECT_EQ(s.ignored, 1u);  // the one inside DontCare (coverage 1)
 }
 
+// The devkit's minimum overlap: 0.7 for car, 0.5 for pedestrian and cyclist. A 100 x 50 label and
+// a detection shifted right by 25 px: IoU = (75 x 50) / (125 x 50) = 0.6, a hit for person and bike
+// but a false alarm and a miss for car; shifted by 15 px: IoU = 85 / 115 = 0.739, a hit for car.
+TEST(KittiRules, MinimumOverlapIsPointSevenForCarAndPointFiveForPersonAndBike) {
+  EXPECT_EQ(kittiMinOverlap("car"), 0.7);
+  EXPECT_EQ(kittiMinOverlap("person"), 0.5);
+  EXPECT_EQ(kittiMinOverlap("bike"), 0.5);
+  for (const std::string cls : {"car", "person", "bike"}) {
+    const Labels labels{label(cls, cls, {100, 50, 100, 50})};
+    const StackMatch at06 = matchDetections({det({125, 50, 100, 50})}, labels, matchConfigFor(cls));
+    const StackMatch at074 = matchDetections({det({115, 50, 100, 50})}, labels, matchConfigFor(cls));
+    const bool car = cls == "car";
+    EXPECT_EQ(at06.hits, car ? 0u : 1u) << cls;
+    EXPECT_EQ(at06.falseAlarms, car ? 1u : 0u) << cls;
+    EXPECT_EQ(at06.misses, car ? 1u : 0u) << cls;
+    EXPECT_EQ(at074.hits, 1u) << cls;
+  }
+  // DontCare absorbs at the class's overlap too (intersection over the detection's area):
+  // 0.6 of the detection inside absorbs it for person, not for car.
+  const Labels dc{label("", "DontCare", {0, 0, 60, 100}, true)};
+  EXPECT_EQ(matchDetections({det({0, 0, 100, 100})}, dc, matchConfigFor("person")).falseAlarms, 0u);
+  EXPECT_EQ(matchDetections({det({0, 0, 100, 100})}, dc, matchConfigFor("car")).falseAlarms, 1u);
+}
+
 TEST(KittiRules, DetectionsBelow25PixelsAreIgnored) {
   const Labels labels{label("car", "Car", {0, 0, 40, 30})};
   // 24 px high, far from any label: ignored, not a false alarm.

@@ -16,8 +16,12 @@ enum class VanPolicy { kIgnore, kNegative, kPositive };
 VanPolicy parseVanPolicy(const std::string& text);  // "ignore" | "negative" | "positive"
 std::string toString(VanPolicy policy);
 
-// KITTI moderate for one class: height >= 25 px, occlusion <= 1, truncation <= 0.3, IoU >= 0.5,
-// detections < 25 px ignored; neighbour classes Van (car, per policy) and Person_sitting (person);
+// The KITTI object devkit's minimum overlap of a hit in 2D (evaluate_object.cpp): 0.7 for car,
+// 0.5 for pedestrian and cyclist (and any other class).
+double kittiMinOverlap(const std::string& className);
+
+// KITTI moderate for one class: height >= 25 px, occlusion <= 1, truncation <= 0.3, IoU >=
+// kittiMinOverlap(class) (car 0.7, person and bike 0.5), detections < 25 px ignored; neighbour classes Van (car, per policy) and Person_sitting (person);
 // DontCare absorbs; Truck, Tram, Misc are false alarms.
 MatchConfig matchConfigFor(const std::string& className, VanPolicy van = VanPolicy::kIgnore);
 
