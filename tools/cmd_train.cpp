@@ -156,7 +156,7 @@ class ConsoleProgress final : public boosting::ProgressSink {
 };
 
 // Recall / precision / F-measure of the new cascade on the held-back items, with `fusedet eval`'s
-// defaults: the KITTI devkit's 2D rules of boost/evaluation.h (moderate, IoU >= 0.5, DontCare,
+// defaults: the KITTI devkit's 2D rules of boost/evaluation.h (moderate, IoU >= 0.7 for car and 0.5 for person and bike, DontCare,
 // neighbouring classes ignored) through boost/chain_evaluation.h; OpenCV-style grouping.
 void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
                       const std::vector<std::string>& testIds) {
@@ -422,7 +422,8 @@ const bool registered = registerCommand(
       app.add_option("--test-list", o->testList, "write the held-back item ids to this file, one per line");
       app.add_flag("--eval", o->eval,
                    "after training, report recall, precision and F-measure on the held-back items (the "
-                   "rules and defaults of `fusedet eval`: IoU >= 0.5, KITTI moderate, ignore regions)");
+                   "rules and defaults of `fusedet eval`: the KITTI devkit's IoU >= 0.7 for car, 0.5 for person and "
+                   "bike, KITTI moderate, ignore regions)");
       app.add_option("--eval-scale-factor", o->evalScaleFactor, "detection scale step for --eval and --validation-part")
           ->capture_default_str();
       app.add_option("--eval-step", o->evalStep, "detection position step for --eval and --validation-part")->capture_default_str();

@@ -133,11 +133,13 @@ std::string renderMarkdown(const ExperimentReport& r) {
           body);
   }
   md << "Evaluation: the KITTI object devkit's 2D rules (boost/evaluation.h). A detection hits a label "
-        "at IoU >= 0.5. Positives are KITTI \"moderate\": box height >= 25 px, occlusion <= 1, "
+        "at the devkit's minimum overlap, IoU >= 0.7 for car and >= 0.5 for person and bike (unless the "
+        "settings' \"hit overlap\" row names an override); DontCare absorbs a detection that lies inside "
+        "it by that share of its area. Positives are KITTI \"moderate\": box height >= 25 px, occlusion <= 1, "
         "truncation <= 0.3 (the tracking-label drives 0005 and 0009 store truncation levels 0/1/2: "
         "level 0 passes, levels 1 and 2 do not). Labels of the class below moderate and of the "
         "neighbouring class (Van for car, Person_sitting for person) are ignored: a detection on them "
-        "counts neither way. DontCare regions absorb detections inside them; Truck, Tram and Misc are "
+        "counts neither way. Truck, Tram and Misc are "
         "false alarms; detections lower than 25 px are ignored. Precision without any detection is "
         "undefined (null), never 1. F is measured at the operating point (every detection the "
         "cascade outputs after grouping); AP interpolates precision at 40 recall points (KITTI since "
