@@ -75,6 +75,7 @@ struct ExperimentOptions {
   int validationPart = -1;  // -1 = the preset's
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
+  bool softCascade = false;
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
@@ -295,6 +296,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.match = match;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
+  c.softCascade = o.softCascade;
   c.samples.jitterCopies = o.jitter;
   return c;
 }
@@ -536,6 +538,7 @@ int runExperiments(ExperimentOptions o) {
                                                ", person and bike " + shortNum(boosting::kittiMinOverlap("person"))},
       {"minimum detection height", o.minHeightFromPositives ? "smallest training positive (model's min_height)"
                                                             : "base window"},
+      {"cascade", o.softCascade ? "soft (cumulative stage sums; detection score = the final cumulative sum)" : "hard"},
       {"fold model cache", cache.string()},
       {"jittered copies per positive", std::to_string(o.jitter)},
   };
@@ -967,6 +970,9 @@ const bool registered = registerCommand(
       app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
                    "models store their smallest training positive's height as minimum detection height "
                    "(default: detection scans from the base window)");
+      app.add_flag("--soft-cascade", o->softCascade,
+                   "train soft cascades (as `fusedet train --soft-cascade`: every stage boosts on from the "
+                   "cumulative score and thresholds it); part of the fold-model cache key. Default: hard cascades");
       app.add_option("--max-fa", o->stageMaxFalseAlarm,
                      "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
                      "longer stages whose sums average more stumps")

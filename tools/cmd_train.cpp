@@ -49,6 +49,7 @@ struct TrainOptions {
   int validationPart = 0;
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
+  bool softCascade = false;
   bool vanNegative = false;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
@@ -213,6 +214,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.part = o.validationPart;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
+  c.softCascade = o.softCascade;
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
@@ -310,6 +312,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"stop_reason", report.stopReason},
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
+  if (c.softCascade) info.emplace_back("cascade", "soft");
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
                                              std::to_string(report.validationItems) + " items, " +
@@ -402,6 +405,12 @@ const bool registered = registerCommand(
                    "store the smallest training positive's height in the model as its minimum detection height "
                    "(\"min_height\"; detection scans from there unless given a minimum size); default: scan from "
                    "the base window");
+      app.add_flag("--soft-cascade", o->softCascade,
+                   "train a soft cascade (boosting chain): each stage goes on boosting from the samples' "
+                   "cumulative score of the stages before (weights exp(-y F), each class half the weight) and its "
+                   "threshold applies to that cumulative sum; the model file records it (\"cascade\": \"soft\", "
+                   "format version 3). Not with --validation-part or MPI. Default: hard cascade (every stage's sum "
+                   "from 0)");
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
                    "negative windows on them)");

@@ -73,6 +73,7 @@ void Cascade::validate() const {
       if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
     }
   }
+  if (soft && isOpenCv()) fail("an imported OpenCV cascade cannot be a soft cascade");
   const bool trees = hasTrees();
   if (trees && !isOpenCv()) fail("decision trees are only supported in imported OpenCV cascades");
   if (trees && treeStages.size() != stages.size())

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <tuple>
 #include <stdexcept>
 
 namespace fusedet::boosting {
@@ -16,18 +18,40 @@ double stageThreshold(std::vector<double> scores, double minHit) {
   return t - 1e-9 * std::max(1.0, std::fabs(t));
 }
 
+std::vector<double> softStartWeights(std::span<const double> start, std::size_t positives) {
+  const std::size_t n = start.size();
+  std::vector<double> w(n);
+  for (const auto& [lo, hi, y] : {std::tuple{std::size_t(0), positives, 1.0}, std::tuple{positives, n, -1.0}}) {
+    if (lo >= hi) continue;
+    // exp(-y F - m) with m the class's largest exponent: no overflow for any F, the same ratios.
+    double m = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = lo; i < hi; ++i) m = std::max(m, -y * start[i]);
+    double sum = 0;
+    for (std::size_t i = lo; i < hi; ++i) sum += w[i] = std::exp(-y * start[i] - m);
+    for (std::size_t i = lo; i < hi; ++i) w[i] = 0.5 * w[i] / sum;
+  }
+  return w;
+}
+
 StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
                        const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                       const HeldOutPositives* heldOut) {
+                       const HeldOutPositives* heldOut, std::span<const double> startScores) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
+  if (!startScores.empty() && startScores.size() != n)
+    throw std::invalid_argument("trainStage: " + std::to_string(startScores.size()) + " start scores for " +
+                                std::to_string(n) + " samples");
+  if (!startScores.empty() && heldOut)
+    throw std::invalid_argument("trainStage: held-out positives and start scores (soft cascade) together are not supported");
   // Each class starts with half the weight, so the first stump is not dominated by the larger set.
   std::vector<double> w(n);
   for (std::size_t i = 0; i < n; ++i)
     w[i] = i < positives ? 0.5 / double(positives) : 0.5 / double(n - positives);
+  if (!startScores.empty()) w = softStartWeights(startScores, positives);
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
+  if (!startScores.empty()) score.assign(startScores.begin(), startScores.end());
   std::vector<float> values(n);
   const std::size_t held = heldOut ? heldOut->count : 0;
   std::vector<double> heldScore(held, 0.0);
@@ -71,7 +95,8 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
 
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut) {
+                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut,
+                       std::span<const double> startScores) {
   StumpSearchOptions search;
   search.threads = config.threads;
   search.refineTop = config.refineTop;
@@ -82,7 +107,7 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
         rawValues(s.feature, chosen);
         return s;
       },
-      config, onRound, heldOut);
+      config, onRound, heldOut, startScores);
 }
 
 }  // namespace fusedet::boosting

@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -512,4 +515,73 @@ TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
   EXPECT_DOUBLE_EQ(second.trainSeconds, recorded);
   EXPECT_EQ(modelToText(loaded), modelToText(trained));
   std::filesystem::remove_all(dir);
+}
+
+// Soft cascade: the trained stages' thresholds and the detector's scores are the cumulative sums,
+// recomputed here from featureValue() stump by stump on every training positive (incl. mirrored
+// copies): stage k's threshold lies just below the weakest cumulative score of the positives that
+// passed stages 1..k-1 (min hit 0.995 of < 200 positives drops none), as stageThreshold() nudges it.
+TEST(CascadeTrainer, SoftCascadeThresholdsAreOnTheCumulativeScoresOfThePositives) {
+  const auto items = scenes(12, true);
+  TrainingConfig config = smallConfig();
+  config.pool.layers = {"intensity", "hue_distance"};
+  config.targetFalseAlarm = 1e-9;
+  config.softCascade = true;
+  NullProgress quiet;
+  TrainingReport report;
+  const Cascade soft = trainCascade(config, items, quiet, &report);
+  ASSERT_TRUE(soft.soft);
+  ASSERT_GE(soft.stages.size(), 2u) << report.stopReason;
+  config.samples.className = config.className;
+  const TrainingStacks stacks(items, config.pool.layers, soft.referenceHue, config.samples);
+  ASSERT_EQ(stacks.positives().size(), report.positives);
+  std::vector<double> cumulative(stacks.positives().size(), 0.0);
+  std::vector<bool> alive(stacks.positives().size(), true);
+  std::size_t differs = 0;
+  for (std::size_t k = 0; k < soft.stages.size(); ++k) {
+    const Stage& st = soft.stages[k];
+    double weakest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < stacks.positives().size(); ++i) {
+      if (!alive[i]) continue;
+      const Sample& v = stacks.positives()[i];
+      double stageSum = 0;
+      for (const Stump& t : st.stumps) {
+        const float value = featureValue(stacks.integrals(v.stack), soft.features[static_cast<std::size_t>(t.feature)], v.window);
+        const double leaf = value < static_cast<float>(t.threshold) ? t.left : t.right;
+        cumulative[i] += leaf;
+        stageSum += leaf;
+      }
+      weakest = std::min(weakest, cumulative[i]);
+      if (k > 0 && (stageSum >= st.threshold) != (cumulative[i] >= st.threshold)) ++differs;
+    }
+    EXPECT_EQ(st.threshold, weakest - 1e-9 * std::max(1.0, std::fabs(weakest))) << "stage " << k + 1;
+    for (std::size_t i = 0; i < alive.size(); ++i) alive[i] = alive[i] && cumulative[i] >= st.threshold;
+  }
+  // The detector's one-window path gives those cumulative sums as scores.
+  std::size_t accepted = 0;
+  for (std::size_t i = 0; i < alive.size(); ++i) {
+    const Sample& v = stacks.positives()[i];
+    const WindowResult r = evaluateWindow(soft, stacks.integrals(v.stack), v.window);
+    EXPECT_EQ(r.accepted, bool(alive[i]));
+    if (r.accepted) {
+      EXPECT_EQ(r.score, cumulative[i]);
+      ++accepted;
+    }
+  }
+  EXPECT_GT(accepted, 0u);
+  EXPECT_GT(differs, 0u) << "the thresholds should decide differently on a stage's own sum";
+  // Stage 1 starts from 0 for every sample: the hard training's first stage.
+  config.softCascade = false;
+  config.maxStages = 1;
+  Cascade firstSoft = firstStages(soft, 1);
+  firstSoft.soft = false;
+  EXPECT_EQ(modelToText(firstSoft), modelToText(trainCascade(config, items, quiet)));
+  // Written and read back as a soft cascade; not with a validation part.
+  EXPECT_TRUE(modelFromText(modelToText(soft), "soft.json").soft);
+  config.softCascade = true;
+  config.validation.part = 3;
+  EXPECT_THROW(config.validate(), std::invalid_argument);
+  // And it still finds the unseen scenes' cars.
+  const Found f = findCars(Detector(soft), [](DatasetItem&) {});
+  EXPECT_GE(double(f.found), 0.8 * double(f.cars)) << f.found << " of " << f.cars << "; " << report.stopReason;
 }

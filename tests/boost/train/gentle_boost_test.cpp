@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 using namespace fusedet::boosting;
@@ -105,4 +106,50 @@ TEST(GentleBoost, HeldOutPositivesPlaceTheThresholdAndTheStageGoesOn) {
   EXPECT_EQ(r.hitRate, 1.0);
   EXPECT_FALSE(r.reachedFalseAlarm);
   EXPECT_EQ(r.stumps.size(), 2u);
+}
+
+// Soft cascade (boosting chain): the stage starts from the samples' cumulative scores F. Worked
+// example, the fixed stump x < 3.5 ? -1 : +1 on positives 5, 6 and negatives 1, 2 with F = 0.5,
+// 3, 2.6, -2: the first round's weights are exp(-y F) per class, each class summing to 1/2;
+// the sums go on from F (1.5, 4, 3.6 - 1 = 1.6, -3), the threshold lies just below the weakest
+// positive's 1.5 and negative 1 (1.6) passes it: false-alarm rate 0.5, complete.
+TEST(GentleBoost, SoftCascadeStageBoostsOnFromTheCumulativeScores) {
+  const std::vector<float> values = {5, 6, 1, 2};
+  const std::vector<double> start = {0.5, 3.0, 2.6, -2.0};
+  std::vector<float> firstWeights;
+  const StumpFinder find = [&](std::span<const float> weights, std::span<float> chosen) {
+    if (firstWeights.empty()) firstWeights.assign(weights.begin(), weights.end());
+    std::copy(values.begin(), values.end(), chosen.begin());
+    FittedStump s;
+    s.threshold = 3.5f;
+    s.left = -1;
+    s.right = 1;
+    return s;
+  };
+  StageConfig c;
+  c.maxWeak = 3;
+  const StageResult r = boostStage(4, 2, find, c, {}, nullptr, start);
+  const double p0 = std::exp(-0.5), p1 = std::exp(-3.0), n0 = std::exp(2.6), n1 = std::exp(-2.0);
+  ASSERT_EQ(firstWeights.size(), 4u);
+  EXPECT_FLOAT_EQ(firstWeights[0], float(0.5 * p0 / (p0 + p1)));
+  EXPECT_FLOAT_EQ(firstWeights[1], float(0.5 * p1 / (p0 + p1)));
+  EXPECT_FLOAT_EQ(firstWeights[2], float(0.5 * n0 / (n0 + n1)));
+  EXPECT_FLOAT_EQ(firstWeights[3], float(0.5 * n1 / (n0 + n1)));
+  EXPECT_EQ(r.stumps.size(), 1u);
+  EXPECT_NEAR(r.threshold, 1.5, 1e-8);
+  EXPECT_LT(r.threshold, 1.5);
+  EXPECT_EQ(r.hitRate, 1.0);
+  EXPECT_EQ(r.falseAlarm, 0.5);
+  EXPECT_TRUE(r.reachedFalseAlarm);
+  // The same stage from 0 (a hard cascade): sums 1, 1, -1, -1, threshold just below 1, no false alarm.
+  const StageResult hard = boostStage(4, 2, find, c);
+  EXPECT_NEAR(hard.threshold, 1.0, 1e-8);
+  EXPECT_EQ(hard.falseAlarm, 0.0);
+  // Scores far beyond exp's range still give finite weights with the same ratios within a class.
+  const std::vector<double> w = softStartWeights(std::vector<double>{-800.0, -801.0, 900.0, 5.0}, 2);
+  EXPECT_NEAR(w[0] / w[1], std::exp(-1.0), 1e-12);
+  EXPECT_DOUBLE_EQ(w[0] + w[1], 0.5);
+  EXPECT_DOUBLE_EQ(w[2], 0.5);
+  EXPECT_EQ(w[3], 0.0);  // exp(-895) underflows: that negative is nothing next to the other
+  EXPECT_THROW(boostStage(4, 2, find, c, {}, nullptr, std::vector<double>{1, 2}), std::invalid_argument);
 }

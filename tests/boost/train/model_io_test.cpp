@@ -225,7 +225,7 @@ TEST(ModelIo, BadContrastNormalisedFieldIsAClearError) {
                 .find("contrast_normalised[2]: layer 'intensity' listed twice"),
             std::string::npos);
   EXPECT_NE(with("{\"intensity\": true}").find("expected an array, got object"), std::string::npos);
-  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 3")).find("unsupported version 3 (this build reads 1 to 2)"),
+  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 4")).find("unsupported version 4 (this build reads 1 to 3)"),
             std::string::npos);
   // Invalid in memory: flags of the wrong size.
   c.contrastNormalised = {true};
@@ -259,5 +259,82 @@ TEST(ModelIo, FuzzedContrastNormalisedFieldNeverCrashes) {
     }
   }
   EXPECT_GT(rejected, 0);
+  EXPECT_EQ(loaded + rejected, 2000);
+}
+
+// Soft cascades (cascade.h): "cascade": "soft", format version 3; absent = hard, as in every
+// older file, whose bytes do not change.
+TEST(ModelIo, SoftCascadeIsRecordedAndOlderFilesAreHard) {
+  const std::string hard = modelToText(sample());
+  EXPECT_EQ(hard.find("\"cascade\""), std::string::npos);
+  EXPECT_NE(hard.find("\"version\": 1"), std::string::npos);
+  EXPECT_FALSE(modelFromText(hard, "old.json").soft);
+  Cascade c = sample();
+  c.soft = true;
+  const std::string text = modelToText(c);
+  EXPECT_NE(text.find("\"version\": 3"), std::string::npos);
+  EXPECT_NE(text.find("\"cascade\": \"soft\""), std::string::npos);
+  const Cascade back = modelFromText(text, "m.json");
+  EXPECT_TRUE(back.soft);
+  EXPECT_EQ(modelToText(back), text);
+  // "hard" spelled out is a hard cascade; with contrast normalisation the soft model is version 3 too.
+  EXPECT_FALSE(modelFromText(replace(text, "\"soft\"", "\"hard\""), "m.json").soft);
+  c.contrastNormalised = {true, false};
+  const std::string both = modelToText(c);
+  EXPECT_NE(both.find("\"version\": 3"), std::string::npos);
+  EXPECT_TRUE(modelFromText(both, "m.json").soft);
+  EXPECT_TRUE(modelFromText(both, "m.json").isContrastNormalised(0));
+}
+
+TEST(ModelIo, UnknownCascadeKindIsAClearError) {
+  Cascade c = sample();
+  c.soft = true;
+  const std::string good = modelToText(c);
+  const std::string field = "\"cascade\": \"soft\"";
+  auto with = [&](const std::string& value) { return errorOf(replace(good, field, "\"cascade\": " + value)); };
+  EXPECT_NE(with("\"chain\"").find("m.json: cascade: unknown cascade kind 'chain' (expected \"hard\" or \"soft\")"),
+            std::string::npos)
+      << with("\"chain\"");
+  EXPECT_NE(with("\"Soft\"").find("unknown cascade kind 'Soft'"), std::string::npos);
+  EXPECT_NE(with("true").find("m.json: cascade: expected a string, got boolean"), std::string::npos);
+  EXPECT_NE(with("1").find("cascade: expected a string, got number"), std::string::npos);
+  EXPECT_NE(with("null").find("cascade: expected a string, got null"), std::string::npos);
+  // A soft cascade in a file claiming an older version: refused (an older build would run it hard).
+  EXPECT_NE(errorOf(replace(good, "\"version\": 3", "\"version\": 1"))
+                .find("m.json: cascade: a soft cascade needs format version 3, the file says 1"),
+            std::string::npos);
+  // OpenCV models are never soft.
+  c.normalization = Normalization::kOpenCvVariance;
+  EXPECT_THROW(c.validate(), std::invalid_argument);
+}
+
+TEST(ModelIo, FuzzedCascadeKindNeverCrashes) {
+  Cascade c = sample();
+  c.soft = true;
+  const std::string good = modelToText(c);
+  const std::size_t at = good.find("\"version\"");
+  const std::size_t end = good.find("\"stages\"");
+  ASSERT_NE(good.find("\"cascade\""), std::string::npos);
+  std::mt19937 rng(15);
+  int loaded = 0, rejected = 0, soft = 0;
+  for (int it = 0; it < 2000; ++it) {
+    std::string s = good;
+    const std::size_t p = at + rng() % (end - at);
+    switch (rng() % 3) {
+      case 0: s[p] = "{}[],:\"0-e9.shardft "[rng() % 20]; break;
+      case 1: s.erase(p, 1 + rng() % 6); break;
+      default: s.insert(p, 1, "{}[],:\"0-e9.shardft "[rng() % 20]); break;
+    }
+    try {
+      const Cascade back = modelFromText(s, "fuzz.json");
+      soft += back.soft;
+      ++loaded;
+    } catch (const ModelError& e) {
+      EXPECT_NE(std::string(e.what()).find("fuzz.json"), std::string::npos) << e.what();
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+  EXPECT_GT(soft, 0);
   EXPECT_EQ(loaded + rejected, 2000);
 }

@@ -53,6 +53,10 @@ struct TrainingConfig {
   // Store the smallest training positive's height as the model's minimum detection height
   // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
   bool minHeightFromPositives = false;
+  // Soft cascade (cascade.h, gentle_boost.h boostStage's startScores): each stage goes on boosting
+  // from the samples' cumulative scores of the stages before, and its threshold applies to the
+  // cumulative sum. Off by default; in-process training without a validation part only.
+  bool softCascade = false;
   // The pool's values on every positive are evaluated once per training and kept (pool x
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.

@@ -37,13 +37,13 @@ struct ScanParams {
 
 struct WindowResult {
   bool accepted = false;
-  double score = 0;      // sum of the last stage evaluated
+  double score = 0;      // sum of the last stage evaluated (soft cascade: the cumulative sum)
   int stagesPassed = 0;  // == stage count when accepted
 };
 
 struct RawHit {
   Box box;           // reference pixels
-  double score = 0;  // sum of the last stage
+  double score = 0;  // sum of the last stage (soft cascade: of every stump)
   int scale = 0;     // index of the scale the window was found at
 };
 

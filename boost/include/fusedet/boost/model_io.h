@@ -12,6 +12,7 @@
 //     "layers": ["intensity","distance"],
 //     "reference_hue": 25,
 //     "contrast_normalised": ["intensity"],   (version 2 only; optional; absent = none)
+//     "cascade": "soft",                      (version 3; optional: "hard" | "soft", absent = hard)
 //     "training": {"seed":"1", ...},          (optional, informative, ignored when loading)
 //     "stages": [
 //       {"threshold":-0.41,"stumps":[
@@ -33,9 +34,10 @@
 namespace fusedet::boosting {
 
 // Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
-// standard deviation, feature.h); models without it are still written as version 1, byte for
-// byte as before. Both versions load.
-inline constexpr int kModelFormatVersion = 2;
+// standard deviation, feature.h); version 3 adds "cascade": "soft" (cascade.h: cumulative stage
+// sums; an older build refuses the file instead of running it as a hard cascade). Models without
+// them are still written as version 1, byte for byte as before. Every version loads.
+inline constexpr int kModelFormatVersion = 3;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.
