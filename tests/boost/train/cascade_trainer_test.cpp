@@ -522,9 +522,8 @@ TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
 // copies): stage k's threshold lies just below the weakest cumulative score of the positives that
 // passed stages 1..k-1 (min hit 0.995 of < 200 positives drops none), as stageThreshold() nudges it.
 TEST(CascadeTrainer, SoftCascadeThresholdsAreOnTheCumulativeScoresOfThePositives) {
-  const auto items = scenes(12, true);
+  const auto items = scenes(12, false);
   TrainingConfig config = smallConfig();
-  config.pool.layers = {"intensity", "hue_distance"};
   config.targetFalseAlarm = 1e-9;
   config.softCascade = true;
   NullProgress quiet;
