@@ -59,6 +59,17 @@ TEST(GentleBoost, StageReachesFalseAlarmAtHitRateOnSeparableData) {
   EXPECT_DOUBLE_EQ(double(fas) / (n - pos), r.falseAlarm);
 }
 
+namespace {
+// The worked examples' fixed stump: x < 3.5 ? -1 : +1.
+FittedStump fixedStump() {
+  FittedStump s;
+  s.threshold = 3.5f;
+  s.left = -1;
+  s.right = 1;
+  return s;
+}
+}  // namespace
+
 // Worked example of held-out positives placing the threshold: a fixed stump x < 3.5 ? -1 : +1 on
 // training positives 5, 6 and negatives 1, 2 (all scores +-1) and held-out positives 4, 3, 7.
 TEST(GentleBoost, HeldOutPositivesPlaceTheThresholdAndTheStageGoesOn) {
@@ -66,11 +77,7 @@ TEST(GentleBoost, HeldOutPositivesPlaceTheThresholdAndTheStageGoesOn) {
   const StumpFinder find = [&](std::span<const float> weights, std::span<float> chosen) {
     EXPECT_EQ(weights.size(), 4u);  // held-out positives are no training samples
     std::copy(train.begin(), train.end(), chosen.begin());
-    FittedStump s;
-    s.threshold = 3.5f;
-    s.left = -1;
-    s.right = 1;
-    return s;
+    return fixedStump();
   };
   StageConfig c;
   c.maxWeak = 2;
@@ -120,11 +127,7 @@ TEST(GentleBoost, SoftCascadeStageBoostsOnFromTheCumulativeScores) {
   const StumpFinder find = [&](std::span<const float> weights, std::span<float> chosen) {
     if (firstWeights.empty()) firstWeights.assign(weights.begin(), weights.end());
     std::copy(values.begin(), values.end(), chosen.begin());
-    FittedStump s;
-    s.threshold = 3.5f;
-    s.left = -1;
-    s.right = 1;
-    return s;
+    return fixedStump();
   };
   StageConfig c;
   c.maxWeak = 3;
