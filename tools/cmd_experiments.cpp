@@ -6,6 +6,7 @@
 // directory. The rules live in boost/ (data_split, cross_validation, bootstrap, evaluation).
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -30,9 +31,11 @@
 #include "fusedet/boost/cross_validation.h"
 #include "fusedet/boost/data_split.h"
 #include "fusedet/boost/experiment_plan.h"
+#include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/fusion/kitti_drives.h"
 #include "fusedet/fusion/kitti_import.h"
+#include "fusedet/fusion/kitti_tracks.h"
 #include "fusedet/fusion/layer_sources.h"
 
 namespace fusedet::tools {
@@ -57,6 +60,9 @@ struct ExperimentOptions {
   int learningFolds = -1;  // -1 = the preset's
   std::vector<std::string> learning;  // training drives per fold for the learning curve
   bool learningSet = false;
+  std::vector<std::string> learningPositives;  // training positives per fold for the second curve
+  bool learningPositivesSet = false;
+  bool trainingScore = true;  // score every learning-curve point on its own training frames
   std::size_t resamples = 0;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -146,11 +152,33 @@ std::string presets(T boosting::ExperimentPlan::*field) {
   return presets([field](const boosting::ExperimentPlan& p) { return shortNum(static_cast<double>(p.*field)); });
 }
 
-std::string learningText(const std::vector<std::size_t>& drives) {
-  if (drives.empty()) return "none";
+std::string learningText(const std::vector<std::size_t>& counts) {
+  if (counts.empty()) return "none";
   std::vector<std::string> v;
-  for (std::size_t k : drives) v.push_back(k == 0 ? "all" : std::to_string(k));
+  for (std::size_t k : counts) v.push_back(k == 0 ? "all" : std::to_string(k));
   return joined(v);
+}
+
+// "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).
+std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option) {
+  std::vector<std::size_t> out;
+  for (const std::string& v : values) {
+    if (v == "none") continue;
+    if (v == "all") {
+      out.push_back(0);
+      continue;
+    }
+    std::size_t used = 0;
+    unsigned long n = 0;
+    try {
+      n = std::stoul(v, &used);
+    } catch (const std::logic_error&) {
+      used = 0;
+    }
+    if (used != v.size() || n == 0) throw std::runtime_error(option + ": '" + v + "' is not a count >= 1, all or none");
+    out.push_back(n);
+  }
+  return out;
 }
 
 // Drive directories under a KITTI root: the three shared ones first (in the documented order),
@@ -229,6 +257,27 @@ std::vector<std::string> drivesOf(const ExperimentOptions& o, const std::vector<
   return drives;
 }
 
+// The physical object of every label (boost/learning_curve.h): "<drive>/track <id>" where the
+// KITTI folder has its tracking label file (fusion/kitti_tracks.h), else "" (counted once).
+std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, const std::vector<DatasetEntry>& manifest,
+                                                  const std::vector<Labels>& labels,
+                                                  const std::vector<std::string>& driveOf) {
+  std::map<std::string, fusion::KittiTracks> tracks;
+  if (!fs::exists(o.data / "dataset.json"))
+    for (const fs::path& d : kittiDrives(o.data)) tracks[d.filename().string()] = fusion::readKittiTracks(d);
+  std::vector<std::vector<std::string>> out(manifest.size());
+  for (std::size_t i = 0; i < manifest.size(); ++i) {
+    const auto it = tracks.find(manifest[i].group);
+    if (it == tracks.end() || it->second.frames.empty()) continue;
+    const std::string frame = manifest[i].id.substr(manifest[i].id.find('/') + 1);
+    int number = -1;
+    const auto [end, ec] = std::from_chars(frame.data(), frame.data() + frame.size(), number);
+    if (ec == std::errc() && end == frame.data() + frame.size())
+      out[i] = it->second.objectIds(driveOf[i], number, labels[i]);
+  }
+  return out;
+}
+
 // The preset (boost/experiment_plan.h) with the options given on the command line.
 boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   boosting::ExperimentPlan p = boosting::experimentPlan(o.preset);
@@ -248,20 +297,9 @@ boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   if (o.peerUpscale > 0) p.peerUpscale = o.peerUpscale;
   if (!o.configs.empty()) p.configs = o.configs;
   if (!o.configClasses.empty()) p.configClasses = o.configClasses;
-  if (o.learningSet) {
-    p.learningDrives.clear();
-    for (const std::string& v : o.learning) {
-      if (v == "none") continue;
-      if (v == "all") {
-        p.learningDrives.push_back(0);
-        continue;
-      }
-      std::size_t used = 0;
-      const unsigned long n = std::stoul(v, &used);
-      if (used != v.size() || n == 0) throw std::runtime_error("--learning: '" + v + "' is not a drive count >= 1, all or none");
-      p.learningDrives.push_back(n);
-    }
-  }
+  if (o.learningSet) p.learningDrives = parseLearningCounts(o.learning, "--learning");
+  if (o.learningPositivesSet) p.learningPositives = parseLearningCounts(o.learningPositives, "--learning-positives");
+  if (!o.trainingScore) p.trainingScore = false;
   return p;
 }
 
@@ -485,15 +523,19 @@ int runExperiments(ExperimentOptions o) {
 
   std::vector<Labels> labels;
   for (const auto& e : manifest) labels.push_back(readDatasetItemLabels(dataset, e.id).labels);
+  const std::vector<std::vector<std::string>> objectIds = objectIdsOf(o, manifest, labels, driveOf);
+  boosting::Fold everyItem;  // every item as training items: the data set's counts
+  for (std::size_t i = 0; i < labels.size(); ++i) everyItem.train.push_back(i);
   for (const std::string& cls : o.classes) {
     const boosting::MatchConfig m = matchFor(cls);
     const boosting::InstanceCount n = boosting::countInstances(labels, m);
     std::set<std::string> drives;
     for (std::size_t i = 0; i < labels.size(); ++i)
       if (boosting::countInstances({labels[i]}, m).positives) drives.insert(driveOf[i]);
-    report.counts.push_back({cls, n.positives, n.ignoredLabels, n.frames, drives.size()});
-    std::printf("%-7s %zu positives (moderate) in %zu frames of %zu drives, %zu ignored labels\n", cls.c_str(),
-                n.positives, n.frames, drives.size(), n.ignoredLabels);
+    const std::size_t objects = boosting::countTrainingSet(everyItem, labels, driveOf, objectIds, m).objects;
+    report.counts.push_back({cls, n.positives, n.ignoredLabels, n.frames, drives.size(), objects});
+    std::printf("%-7s %zu positives (moderate) in %zu frames of %zu drives, %zu ignored labels, %zu distinct objects\n",
+                cls.c_str(), n.positives, n.frames, drives.size(), n.ignoredLabels, objects);
   }
   std::fflush(stdout);
 
@@ -511,6 +553,9 @@ int runExperiments(ExperimentOptions o) {
                                                        : "; other than `all` for " + joined(preset.configClasses) + " only")},
       {"learning curve (training drives per fold)",
        learningText(preset.learningDrives) + " on " + foldsText(learningFolds.size(), driveCount)},
+      {"learning curve (training positives per fold)",
+       learningText(preset.learningPositives) + " on " + foldsText(learningFolds.size(), driveCount)},
+      {"learning curve scored on its training frames", preset.trainingScore ? "yes" : "no"},
       {"folds", foldsText(folds.size(), driveCount)},
       {"pool grid (units per side)", std::to_string(preset.grid)},
       {"max stages", std::to_string(preset.maxStages)},
@@ -629,22 +674,8 @@ int runExperiments(ExperimentOptions o) {
       if (!pr.empty())
         cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
                     lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
-      Series lc{"F (all)", {}, {}}, lcAp{"AP (all)", {}, {}};
-      const auto addPoint = [](Series& se, std::size_t drives, const Estimate& e) {
-        if (!e.value) return;
-        se.points.push_back({static_cast<double>(drives), *e.value});
-        se.band.push_back(e.interval ? std::make_pair(e.interval->lo, e.interval->hi)
-                                     : std::make_pair(*e.value, *e.value));
-      };
-      for (const LearningPoint& p : report.learning)
-        if (p.className == cls) {
-          addPoint(lc, p.drives, p.f);
-          addPoint(lcAp, p.drives, p.ap);
-        }
-      if (!lc.points.empty())
-        cv::imwrite((o.out / ("learning_" + cls + ".png")).string(),
-                    lineChart(cls + ": F and AP vs training drives per fold (95% CI)", "training drives", "F, AP",
-                              static_cast<double>(mostDrives), {lc, lcAp}));
+      if (const cv::Mat chart = learningChart(cls, report.learning); !chart.empty())
+        cv::imwrite((o.out / ("learning_" + cls + ".png")).string(), chart);
     }
     const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
     for (const ConfigResult& all : report.results) {
@@ -770,36 +801,89 @@ int runExperiments(ExperimentOptions o) {
       writeSoFar(false);
     }
   }
+  // Learning curves of `all`: over training drives and over training positives per fold, each
+  // point also scored on its own training frames. A subset already measured (the same training
+  // items in every fold, e.g. "all" on both axes) is not run again.
+  std::map<std::pair<std::string, std::vector<std::vector<std::size_t>>>, LearningPoint> measuredSubsets;
+  const auto learningPoint = [&](const std::string& cls, LearningPoint p, const std::vector<boosting::Fold>& sub,
+                                 const std::string& what) {
+    const boosting::MatchConfig match = matchFor(cls);
+    p.perFold.clear();
+    for (const boosting::Fold& f : sub) p.perFold.push_back(boosting::countTrainingSet(f, labels, driveOf, objectIds, match));
+    std::vector<std::vector<std::size_t>> trainSets;
+    for (const boosting::Fold& f : sub) trainSets.push_back(f.train);
+    const auto key = std::make_pair(cls, trainSets);
+    if (const auto it = measuredSubsets.find(key); it != measuredSubsets.end()) {
+      const LearningPoint& m = it->second;
+      p.counts = m.counts;
+      p.f = m.f;
+      p.ap = m.ap;
+      p.trainingScored = m.trainingScored;
+      p.trainingCounts = m.trainingCounts;
+      p.trainingF = m.trainingF;
+      p.trainingAp = m.trainingAp;
+    } else {
+      boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
+      spec.scoreTrainingItems = preset.trainingScore;
+      std::vector<boosting::FrameOutcome> frames;
+      bool headline = !preset.trainingScore && learningOnSameFolds;  // the `all` run already has these frames
+      for (std::size_t f = 0; headline && f < sub.size(); ++f) headline = sub[f].train == folds[f].train;
+      if (headline) {
+        frames = framesOf[cls]["all"];
+      } else {
+        std::printf("%s / all, %s (learning curve, %s):\n", cls.c_str(), what.c_str(), report.learningFolds.c_str());
+        const boosting::CrossValidationResult cv =
+            boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log);
+        report.trainSeconds += cv.trainSeconds;
+        foldModels.insert(cv.models.begin(), cv.models.end());
+        frames = cv.frames;
+        if (spec.scoreTrainingItems) {
+          p.trainingScored = true;
+          p.trainingCounts = boosting::countsOf(boosting::allFrames(cv.trainingFrames));
+          const Measured own = measure(cv.trainingFrames, boot);
+          p.trainingF = own.f;
+          p.trainingAp = own.ap;
+        }
+      }
+      p.counts = boosting::countsOf(boosting::allFrames(frames));
+      const Measured mm = measure(frames, boot);
+      p.f = mm.f;
+      p.ap = mm.ap;
+      measuredSubsets[key] = p;
+    }
+    std::string positives;
+    for (const auto& c : p.perFold) positives += (positives.empty() ? "" : "/") + std::to_string(c.positives);
+    std::printf("%-7s learning curve: %s  F %s  AP %s; training frames F %s  AP %s (positives per fold %s)\n",
+                cls.c_str(), what.c_str(), formatEstimate(p.f).c_str(), formatEstimate(p.ap).c_str(),
+                p.trainingScored ? formatEstimate(p.trainingF).c_str() : "-",
+                p.trainingScored ? formatEstimate(p.trainingAp).c_str() : "-", positives.c_str());
+    std::fflush(stdout);
+    report.learning.push_back(p);
+    writeSoFar(false);
+  };
   if (wantAll)
     for (const std::string& cls : o.classes) {
-      const boosting::MatchConfig match = matchFor(cls);
-      const boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
       for (std::size_t k : learning) {
         LearningPoint p;
         p.className = cls;
+        p.axis = "drives";
         p.drives = k;
-        std::vector<boosting::FrameOutcome> frames;
-        if (k >= mostDrives && learningOnSameFolds) {
-          frames = framesOf[cls]["all"];
-        } else {
-          std::vector<boosting::Fold> sub;
-          for (const auto& f : learningFolds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
-          std::printf("%s / all, %zu training drives per fold (learning curve, %s):\n", cls.c_str(), k,
-                      report.learningFolds.c_str());
-          const boosting::CrossValidationResult cv =
-              boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log);
-          report.trainSeconds += cv.trainSeconds;
-          foldModels.insert(cv.models.begin(), cv.models.end());
-          frames = cv.frames;
-        }
-        p.counts = boosting::countsOf(boosting::allFrames(frames));
-        const Measured mm = measure(frames, boot);
-        p.f = mm.f;
-        p.ap = mm.ap;
-        std::printf("%-7s learning curve: %2zu drives  F %s  AP %s\n", cls.c_str(), p.drives,
-                    formatEstimate(p.f).c_str(), formatEstimate(p.ap).c_str());
-        report.learning.push_back(p);
-        writeSoFar(false);
+        std::vector<boosting::Fold> sub;
+        for (const auto& f : learningFolds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
+        char what[48];
+        std::snprintf(what, sizeof what, "%2zu drives", k);
+        learningPoint(cls, p, sub, what);
+      }
+      const std::vector<std::size_t> positivesOfItem =
+          boosting::positivesPerItem(labels, matchFor(cls));
+      for (std::size_t n : preset.learningPositives) {
+        LearningPoint p;
+        p.className = cls;
+        p.axis = "positives";
+        p.requested = n;
+        std::vector<boosting::Fold> sub;
+        for (const auto& f : learningFolds) sub.push_back(boosting::learningPositivesFold(f, positivesOfItem, n, o.seed));
+        learningPoint(cls, p, sub, n ? ">= " + std::to_string(n) + " positives" : "all positives");
       }
     }
 
@@ -915,6 +999,28 @@ const bool registered = registerCommand(
                    return v.empty() ? std::string("none") : joined(v, ",");
                  }))
           ->delimiter(',');
+      app.add_option_function<std::vector<std::string>>(
+             "--learning-positives",
+             [o](const std::vector<std::string>& v) {
+               o->learningPositives = v;
+               o->learningPositivesSet = true;
+             },
+             "the learning curve of `all` over training positives of the class per fold, on the same folds: "
+             "a seeded nested random subset of each fold's training frames, taken until it holds at least N "
+             "moderate positives (the report records the exact positives, distinct objects - a KITTI tracking "
+             "id counts once -, drives and frames per fold); all = every training frame; none = no curve" +
+                 presets([](const boosting::ExperimentPlan& p) {
+                   std::vector<std::string> v;
+                   for (std::size_t k : p.learningPositives) v.push_back(k ? std::to_string(k) : "all");
+                   return v.empty() ? std::string("none") : joined(v, ",");
+                 }))
+          ->delimiter(',');
+      app.add_flag_callback(
+          "--no-training-score", [o] { o->trainingScore = false; },
+          "do not score the learning-curve points on their own training frames (by default every point is: "
+          "each fold's cascade detects on the frames it was trained on, same detection and KITTI rules, so "
+          "the report shows training F and AP beside held-out F and AP - high training and low held-out F "
+          "that close as data grows mean data limits, low training F means method limits)");
       app.add_option("--bootstrap", o->resamples,
                      "bootstrap resamples of the frames" +
                          presets(&boosting::ExperimentPlan::resamples));
@@ -1009,7 +1115,7 @@ const bool registered = registerCommand(
           "(joint > laser-only, > camera-only, > AND; corners help; beyond the paper: channels help) are "
           "judged with the paired 95 % interval of the difference: \"holds\" only when it lies above 0, "
           "\"contradicted\" when it lies below 0, \"not shown\" when it contains 0 (a tie); a learning curve "
-          "trains `all` on 1, 2, 4, ... drives per fold. OpenCV's HOG people detector runs on every frame as the person peer. Evaluation: the KITTI "
+          "trains `all` on 1, 2, 4, ... drives per fold and on frames holding 8, 16, 32, ... positives per fold, each point also scored on its own training frames. OpenCV's HOG people detector runs on every frame as the person peer. Evaluation: the KITTI "
           "object devkit's 2D rules, moderate (see `fusedet eval --help`). A fold that cannot be trained "
           "(too few positives) counts as detecting nothing.\n"
           "Fold models are cached by a hash of the training settings and training item ids: a rerun with "

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <set>
 #include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -128,8 +129,11 @@ std::string renderMarkdown(const ExperimentReport& r) {
     std::vector<std::vector<std::string>> body;
     for (const ClassCounts& c : r.counts)
       body.push_back({c.className, std::to_string(c.positives), std::to_string(c.ignoredLabels),
-                      std::to_string(c.frames), std::to_string(c.drivesWithPositives)});
-    table(md, {"class", "positives (moderate)", "ignored labels", "frames with a positive", "drives with a positive"},
+                      std::to_string(c.objects), std::to_string(c.frames), std::to_string(c.drivesWithPositives)});
+    table(md,
+          {"class", "positives (moderate)", "ignored labels",
+           "distinct objects among the positives (KITTI tracking ids of drives 0005 / 0009 count once)",
+           "frames with a positive", "drives with a positive"},
           body);
   }
   md << "Evaluation: the KITTI object devkit's 2D rules (boost/evaluation.h). A detection hits a label "
@@ -222,20 +226,56 @@ std::string renderMarkdown(const ExperimentReport& r) {
             body);
   }
   if (!r.learning.empty()) {
-    md << "## Learning curves (F against the number of training drives)\n\n"
+    md << "## Learning curves (F against the amount of training data)\n\n"
           "Configuration `all` per class. Each fold keeps its held-out drive(s) and trains on a seeded "
-          "random subset of the other drives (nested: a larger subset contains the smaller); pooled "
-          "over folds. A curve still rising at the right end says more drives would help (data "
-          "limits); a flat one says the method does.";
+          "random subset of its training data (nested: a larger subset contains the smaller): a number of "
+          "its training drives, or of its training frames taken until they hold at least N positives of "
+          "the class (the drives are very unequal); pooled over folds. Every point is also scored on the "
+          "folds' own training frames (same detection, same KITTI rules; intervals over (fold, frame) "
+          "pairs). High training F with low held-out F that closes as data grows: data-limited (variance); "
+          "low training F: the method or its capacity limits (bias). Per-fold counts are what each fold "
+          "really trained on: positives (moderate), distinct objects among them (a KITTI tracking id of "
+          "drives 0005 / 0009 counts once however many frames show it; every other label once), drives, "
+          "frames.";
     if (!r.learningFolds.empty()) md << " Folds: " << r.learningFolds << ".";
     md << "\n\n";
-    std::vector<std::vector<std::string>> body;
-    for (const LearningPoint& p : r.learning)
-      body.push_back({p.className, std::to_string(p.drives), formatEstimate(p.f), formatEstimate(p.ap),
-                      std::to_string(p.counts.hits) + " / " + std::to_string(p.counts.falseAlarms) + " / " +
-                          std::to_string(p.counts.misses)});
-    table(md, {"class", "training drives per fold", "F [95 % CI]", "AP [95 % CI]", "hits / false alarms / misses"},
-          body);
+    const auto hfm = [](const boosting::Counts& c) {
+      return std::to_string(c.hits) + " / " + std::to_string(c.falseAlarms) + " / " + std::to_string(c.misses);
+    };
+    const auto perFold = [](const LearningPoint& p, std::size_t boosting::TrainingSetCount::*field) {
+      std::string t;
+      for (const auto& c : p.perFold) t += (t.empty() ? "" : " / ") + std::to_string(c.*field);
+      return t.empty() ? std::string("-") : t;
+    };
+    const auto trained = [&](const LearningPoint& p, const Estimate& e) {
+      return p.trainingScored ? formatEstimate(e) : std::string("-");
+    };
+    for (const std::string axis : {"drives", "positives"}) {
+      std::vector<std::vector<std::string>> body;
+      for (const LearningPoint& p : r.learning) {
+        if (p.axis != axis) continue;
+        std::vector<std::string> row = {p.className};
+        if (axis == "drives")
+          row.push_back(std::to_string(p.drives));
+        else
+          row.push_back(p.requested ? std::to_string(p.requested) : "all");
+        row.insert(row.end(), {perFold(p, &boosting::TrainingSetCount::positives),
+                               perFold(p, &boosting::TrainingSetCount::objects),
+                               perFold(p, &boosting::TrainingSetCount::groups),
+                               perFold(p, &boosting::TrainingSetCount::items), formatEstimate(p.f),
+                               formatEstimate(p.ap), hfm(p.counts), trained(p, p.trainingF), trained(p, p.trainingAp),
+                               p.trainingScored ? hfm(p.trainingCounts) : "-"});
+        body.push_back(std::move(row));
+      }
+      if (body.empty()) continue;
+      md << (axis == "drives" ? "### Over training drives\n\n" : "### Over training positives\n\n");
+      table(md,
+            {"class", axis == "drives" ? "training drives per fold" : "positives asked per fold",
+             "positives per fold", "distinct objects per fold", "drives per fold", "frames per fold",
+             "held-out F [95 % CI]", "held-out AP [95 % CI]", "held-out hits / FA / misses",
+             "training F [95 % CI]", "training AP [95 % CI]", "training hits / FA / misses"},
+            body);
+    }
     for (const std::string& cls : r.classes) md << "![learning curve " << cls << "](learning_" << cls << ".png)\n";
     md << "\n";
   }
@@ -335,7 +375,8 @@ json toJson(const ExperimentReport& r) {
   j["counts"] = json::array();
   for (const ClassCounts& c : r.counts)
     j["counts"].push_back({{"class", c.className}, {"positives", c.positives}, {"ignored_labels", c.ignoredLabels},
-                           {"frames", c.frames}, {"drives_with_positives", c.drivesWithPositives}});
+                           {"distinct_objects", c.objects}, {"frames", c.frames},
+                           {"drives_with_positives", c.drivesWithPositives}});
   j["results"] = json::array();
   for (const ConfigResult& c : r.results) {
     json curve = json::array();
@@ -380,10 +421,24 @@ json toJson(const ExperimentReport& r) {
                            {"ap_difference", estimateJson(c.apDifference)}, {"ap_verdict", c.apVerdict}});
   j["learning_curve_folds"] = r.learningFolds;
   j["learning_curve"] = json::array();
-  for (const LearningPoint& p : r.learning)
-    j["learning_curve"].push_back({{"class", p.className}, {"drives", p.drives}, {"f_measure", estimateJson(p.f)},
-                                   {"average_precision", estimateJson(p.ap)}, {"hits", p.counts.hits},
-                                   {"false_alarms", p.counts.falseAlarms}, {"misses", p.counts.misses}});
+  for (const LearningPoint& p : r.learning) {
+    json e{{"class", p.className}, {"axis", p.axis}, {"f_measure", estimateJson(p.f)},
+           {"average_precision", estimateJson(p.ap)}, {"hits", p.counts.hits},
+           {"false_alarms", p.counts.falseAlarms}, {"misses", p.counts.misses}};
+    if (p.axis == "drives")
+      e["drives"] = p.drives;
+    else
+      e["positives_asked"] = p.requested ? json(p.requested) : json("all");
+    e["folds"] = json::array();
+    for (const auto& c : p.perFold)
+      e["folds"].push_back({{"frames", c.items}, {"positives", c.positives}, {"distinct_objects", c.objects},
+                            {"drives", c.groups}});
+    if (p.trainingScored)
+      e["training"] = {{"f_measure", estimateJson(p.trainingF)}, {"average_precision", estimateJson(p.trainingAp)},
+                       {"hits", p.trainingCounts.hits}, {"false_alarms", p.trainingCounts.falseAlarms},
+                       {"misses", p.trainingCounts.misses}};
+    j["learning_curve"].push_back(std::move(e));
+  }
   j["stage_sweep"] = json::array();
   for (const SweepPoint& p : r.sweep)
     j["stage_sweep"].push_back({{"class", p.className}, {"stages", p.stages}, {"min_neighbors", p.minNeighbors},
@@ -473,6 +528,49 @@ cv::Mat lineChart(const std::string& title, const std::string& xLabel, const std
     cv::putText(img, series[s].name, {left + plotW + 40, ly}, font, 0.42, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   }
   return img;
+}
+
+double LearningPoint::meanPositives() const {
+  if (perFold.empty()) return 0;
+  double sum = 0;
+  for (const auto& c : perFold) sum += static_cast<double>(c.positives);
+  return sum / static_cast<double>(perFold.size());
+}
+
+cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points) {
+  std::vector<cv::Mat> panels;
+  for (const std::string axis : {"drives", "positives"}) {
+    Series f{"F held out", {}, {}}, ap{"AP held out", {}, {}}, tf{"F training", {}, {}}, tap{"AP training", {}, {}};
+    double xMax = 0;
+    const auto add = [](Series& se, double x, const Estimate& e) {
+      if (!e.value) return;
+      se.points.push_back({x, *e.value});
+      se.band.push_back(e.interval ? std::make_pair(e.interval->lo, e.interval->hi) : std::make_pair(*e.value, *e.value));
+    };
+    for (const LearningPoint& p : points) {
+      if (p.className != cls || p.axis != axis) continue;
+      const double x = axis == "drives" ? static_cast<double>(p.drives) : p.meanPositives();
+      xMax = std::max(xMax, x);
+      add(f, x, p.f);
+      add(ap, x, p.ap);
+      if (p.trainingScored) {
+        add(tf, x, p.trainingF);
+        add(tap, x, p.trainingAp);
+      }
+    }
+    if (f.points.empty()) continue;
+    std::vector<Series> drawn;
+    for (Series* se : {&f, &ap, &tf, &tap})
+      if (!se->points.empty()) drawn.push_back(std::move(*se));
+    panels.push_back(lineChart(cls + (axis == "drives" ? ": vs training drives per fold (95% CI)"
+                                                       : ": vs training positives per fold (95% CI)"),
+                               axis == "drives" ? "training drives" : "training positives (mean of folds)", "F, AP",
+                               xMax, drawn));
+  }
+  if (panels.empty()) return {};
+  cv::Mat out;
+  cv::hconcat(panels, out);
+  return out;
 }
 
 void writeReport(const std::filesystem::path& dir, const ExperimentReport& report) {

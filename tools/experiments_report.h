@@ -15,6 +15,7 @@
 
 #include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/evaluation.h"
+#include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/precision_recall.h"
 
 namespace fusedet::tools::experiments {
@@ -54,12 +55,23 @@ struct Claim {
   std::string apVerdict;  // the same on AP
 };
 
-// One point of a learning curve: a class's "all" configuration trained on `drives` drives per fold.
+// One point of a learning curve: a class's "all" configuration trained on a subset of each fold's
+// training frames - `drives` drives (axis "drives") or frames holding at least `requested`
+// positives (axis "positives"; 0 = all) - scored on the held-out frames and on its own training
+// frames (bias against variance).
 struct LearningPoint {
   std::string className;
-  std::size_t drives = 0;  // training drives per fold (at most)
+  std::string axis = "drives";  // "drives" or "positives"
+  std::size_t drives = 0;       // axis "drives": training drives per fold (at most)
+  std::size_t requested = 0;    // axis "positives": at least this many per fold (0 = all)
+  std::vector<boosting::TrainingSetCount> perFold;  // what each fold really trained on
   boosting::Counts counts;
   Estimate f, ap;
+  bool trainingScored = false;  // the three below are set
+  boosting::Counts trainingCounts;
+  Estimate trainingF, trainingAp;  // intervals over (fold, training frame) pairs
+
+  double meanPositives() const;  // training positives per fold, mean over folds
 };
 
 // One point of a stage-count sweep: a class's `all` fold cascades cut to their first `stages`
@@ -76,6 +88,7 @@ struct SweepPoint {
 struct ClassCounts {
   std::string className;
   std::size_t positives = 0, ignoredLabels = 0, frames = 0, drivesWithPositives = 0;
+  std::size_t objects = 0;  // distinct physical objects among the positives (boost/learning_curve.h)
 };
 
 // A goal of the issue ("car F >= 0.8"): the measured F, its interval and whether it is met.
@@ -140,6 +153,10 @@ struct Series {
 };
 cv::Mat lineChart(const std::string& title, const std::string& xLabel, const std::string& yLabel, double xMax,
                   const std::vector<Series>& series);
+
+// learning_<class>.png: held-out and training F and AP against training drives per fold and, beside
+// it, against training positives per fold (whichever curves the points hold); empty Mat if none.
+cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points);
 
 // Writes report.md and results.json into `dir` (created if needed).
 void writeReport(const std::filesystem::path& dir, const ExperimentReport& report);

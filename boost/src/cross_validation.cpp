@@ -143,6 +143,9 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
       out.failures.push_back("fold " + name + ": " + e.what());
       if (log) log("fold " + shortName + ": not trained (counted as detecting nothing): " + e.what());
       for (std::size_t i : fold.test) out.frames[i] = frameOutcome({}, matchDetections({}, testItems[i].labels, match));
+      if (spec.scoreTrainingItems)
+        for (std::size_t i : fold.train)
+          out.trainingFrames.push_back(frameOutcome({}, matchDetections({}, testItems[i].labels, match)));
       continue;
     }
     std::vector<const Detector*> chain;
@@ -152,12 +155,26 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     out.summaries.push_back(parts.size() == 1 ? parts.front() : combineSummaries(parts));
     detectMs += eval.msPerStack * static_cast<double>(fold.test.size());
     detected += fold.test.size();
+    std::size_t trainHits = 0, trainFalseAlarms = 0, trainPositives = 0;
+    if (spec.scoreTrainingItems) {
+      const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, setup);
+      out.trainingFrames.insert(out.trainingFrames.end(), own.frames.begin(), own.frames.end());
+      trainHits = own.counts.hits;
+      trainFalseAlarms = own.counts.falseAlarms;
+      trainPositives = own.counts.positives;
+    }
     if (log) {
       char line[256];
       std::snprintf(line, sizeof line, "fold %s: %zu train / %zu test items, %zu hits, %zu false alarms, %zu positives",
                     shortName.c_str(), fold.train.size(), fold.test.size(), eval.counts.hits, eval.counts.falseAlarms,
                     eval.counts.positives);
-      log(line);
+      std::string text = line;
+      if (spec.scoreTrainingItems) {
+        std::snprintf(line, sizeof line, "; on its training items %zu hits, %zu false alarms, %zu positives", trainHits,
+                      trainFalseAlarms, trainPositives);
+        text += line;
+      }
+      log(text);
     }
   }
   out.msPerStack = detected ? detectMs / static_cast<double>(detected) : 0.0;

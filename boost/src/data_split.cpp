@@ -6,6 +6,19 @@
 #include <stdexcept>
 
 namespace fusedet::boosting {
+namespace {
+
+// One seeded Fisher-Yates shuffle per (seed, fold's test groups): prefixes of it are nested subsets.
+template <typename T>
+void shuffleForFold(std::vector<T>& v, const Fold& fold, std::uint64_t seed) {
+  std::uint64_t h = seed * 0x9E3779B97F4A7C15ull;
+  for (const std::string& t : fold.testGroups)
+    for (char c : t) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001B3ull;
+  std::mt19937_64 rng(h);
+  for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[rng() % i]);
+}
+
+}  // namespace
 
 std::size_t firstTestFrame(std::size_t frames, double trainFraction) {
   return static_cast<std::size_t>(std::lround(static_cast<double>(frames) * trainFraction));
@@ -53,6 +66,25 @@ std::size_t trainingGroupCount(const Fold& fold, const std::vector<std::string>&
   return g.size();
 }
 
+Fold learningPositivesFold(const Fold& fold, const std::vector<std::size_t>& positivesOfItem,
+                           std::size_t minPositives, std::uint64_t seed) {
+  std::size_t total = 0;
+  for (std::size_t i : fold.train) total += positivesOfItem.at(i);
+  if (minPositives == 0 || minPositives >= total) return fold;
+  std::vector<std::size_t> order = fold.train;
+  shuffleForFold(order, fold, seed);
+  Fold out;
+  out.testGroups = fold.testGroups;
+  out.test = fold.test;
+  std::size_t held = 0;
+  for (std::size_t k = 0; k < order.size() && held < minPositives; ++k) {
+    out.train.push_back(order[k]);
+    held += positivesOfItem.at(order[k]);
+  }
+  std::sort(out.train.begin(), out.train.end());
+  return out;
+}
+
 Fold learningCurveFold(const Fold& fold, const std::vector<std::string>& groupOfItem, std::size_t groups,
                        std::uint64_t seed) {
   std::vector<std::string> names;
@@ -60,12 +92,7 @@ Fold learningCurveFold(const Fold& fold, const std::vector<std::string>& groupOf
     if (std::find(names.begin(), names.end(), groupOfItem.at(i)) == names.end()) names.push_back(groupOfItem.at(i));
   if (groups >= names.size()) return fold;
   std::sort(names.begin(), names.end());
-  // One shuffle per (seed, fold): prefixes of it are nested subsets.
-  std::uint64_t h = seed * 0x9E3779B97F4A7C15ull;
-  for (const std::string& t : fold.testGroups)
-    for (char c : t) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001B3ull;
-  std::mt19937_64 rng(h);
-  for (std::size_t i = names.size(); i > 1; --i) std::swap(names[i - 1], names[rng() % i]);  // Fisher-Yates
+  shuffleForFold(names, fold, seed);
   const std::set<std::string> keep(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(groups));
   Fold out;
   out.testGroups = fold.testGroups;

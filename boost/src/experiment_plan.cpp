@@ -12,6 +12,7 @@ ExperimentPlan experimentPlan(const std::string& name) {
     p.configs = {"all", "no_corners", "laser", "camera", "and", "channels"};
     p.configClasses = {"car"};
     p.learningDrives = {1, 2, 4, 8, 0};
+    p.learningPositives = {8, 16, 32, 64, 128, 0};
     p.learningFolds = 3;
     return p;
   }
@@ -31,6 +32,7 @@ ExperimentPlan experimentPlan(const std::string& name) {
     p.configs = {"all", "no_corners", "laser", "camera", "and"};
     p.configClasses = {"car"};
     p.learningDrives = {2, 0};
+    p.learningPositives = {16, 0};  // 0 is the drive curve's `all` point: not run twice
     p.learningFolds = 3;
     p.peerUpscale = 1;
     return p;

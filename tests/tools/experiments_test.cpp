@@ -178,6 +178,44 @@ TEST(ExperimentsReport, TablesJsonAndClaimsFollowTheNumbers) {
   EXPECT_GT(chart.cols, 500);
 }
 
+// Learning-curve points: per-fold counts and the training score reach the table and results.json;
+// the chart holds one panel per axis measured.
+TEST(ExperimentsReport, LearningPointsShowTrainingScoreAndWhatEachFoldTrainedOn) {
+  ExperimentReport r;
+  r.classes = {"car"};
+  LearningPoint p;
+  p.className = "car";
+  p.axis = "positives";
+  p.requested = 8;
+  p.perFold = {{3, 10, 1, 4}, {12, 9, 2, 9}};  // frames, positives, drives, distinct objects
+  p.counts.hits = 5;
+  p.counts.falseAlarms = 7;
+  p.counts.misses = 20;
+  p.f = {0.17, boosting::Interval{0.13, 0.21, 200}};
+  p.trainingScored = true;
+  p.trainingCounts.hits = 9;
+  p.trainingF = {0.49, boosting::Interval{0.27, 0.66, 200}};
+  r.learning.push_back(p);
+  EXPECT_DOUBLE_EQ(p.meanPositives(), 9.5);
+  const std::string md = renderMarkdown(r);
+  EXPECT_NE(md.find("### Over training positives"), std::string::npos) << md;
+  EXPECT_EQ(md.find("### Over training drives"), std::string::npos) << md;
+  EXPECT_NE(md.find("| car | 8 | 10 / 9 | 4 / 9 | 1 / 2 | 3 / 12 | 0.17 [0.13, 0.21] |"), std::string::npos) << md;
+  EXPECT_NE(md.find("| 5 / 7 / 20 | 0.49 [0.27, 0.66] |"), std::string::npos) << md;
+  const nlohmann::json j = toJson(r);
+  EXPECT_EQ(j["learning_curve"][0]["positives_asked"], 8);
+  EXPECT_EQ(j["learning_curve"][0]["folds"][1]["distinct_objects"], 9);
+  EXPECT_NEAR(j["learning_curve"][0]["training"]["f_measure"]["value"].get<double>(), 0.49, 1e-12);
+  const cv::Mat one = learningChart("car", r.learning);
+  LearningPoint d = p;
+  d.axis = "drives";
+  d.drives = 2;
+  r.learning.push_back(d);
+  const cv::Mat two = learningChart("car", r.learning);
+  EXPECT_EQ(two.cols, 2 * one.cols);
+  EXPECT_TRUE(learningChart("bike", r.learning).empty());
+}
+
 }  // namespace
 }  // namespace fusedet::tools::experiments
 

@@ -59,6 +59,11 @@ TEST(ExperimentPlan, BundledIsTheDocsResultsPlan) {
   EXPECT_FALSE(runsFor(p, "laser", "person"));
   EXPECT_FALSE(p.learningDrives.empty());
   EXPECT_EQ(p.learningDrives.back(), 0u);  // ends at every training drive
+  // The curve over training positives: from 8 (fewer than person's 6-14 per fold) up, doubling.
+  ASSERT_GE(p.learningPositives.size(), 3u);
+  EXPECT_EQ(p.learningPositives.front(), 8u);
+  EXPECT_EQ(p.learningPositives.back(), 0u);
+  EXPECT_TRUE(p.trainingScore);
   EXPECT_GE(p.resamples, 1000u);
 }
 
@@ -71,6 +76,8 @@ TEST(ExperimentPlan, QuickIsSmallerInEveryCostlyPart) {
   EXPECT_GT(q.trainStep, b.trainStep);
   EXPECT_GT(q.folds, 0);  // drive-disjoint folds, not one per drive
   EXPECT_LT(q.learningDrives.size(), b.learningDrives.size());
+  EXPECT_LT(q.learningPositives.size(), b.learningPositives.size());
+  EXPECT_FALSE(q.learningPositives.empty());  // the quick test runs that curve too
   EXPECT_EQ(std::find(q.configs.begin(), q.configs.end(), "channels"), q.configs.end());
 }
 

@@ -9,6 +9,7 @@
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/cross_validation.h"
 #include "fusedet/boost/data_split.h"
+#include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/precision_recall.h"
 
 namespace fusedet::boosting {
@@ -206,6 +207,82 @@ TEST(DataSplit, LearningCurveSubsetsAreNestedAndSeeded) {
   EXPECT_EQ(learningCurveFold(f, g, 3, 3).train, three.train);
   EXPECT_EQ(learningCurveFold(f, g, 99, 3).train, f.train);
   EXPECT_EQ(three.test, f.test);
+}
+
+// Training frames taken until they hold N positives: 10 frames of fold "a"'s training side with
+// 0, 3, 1, 0, 2, 5, 0, 1, 4, 2 positives (18 in all).
+TEST(DataSplit, LearningPositivesSubsetsHoldNAreNestedAndSeeded) {
+  std::vector<std::string> g{"a", "a"};
+  std::vector<std::size_t> pos{7, 7};  // the held-out frames: never taken
+  const std::size_t counts[] = {0, 3, 1, 0, 2, 5, 0, 1, 4, 2};
+  for (std::size_t i = 0; i < 10; ++i) {
+    g.push_back(i < 5 ? "b" : "c");
+    pos.push_back(counts[i]);
+  }
+  const Fold f = crossGroupFolds(g)[0];  // tests "a" (items 0, 1), trains items 2..11
+  ASSERT_EQ(f.train.size(), 10u);
+  const auto held = [&](const Fold& x) {
+    std::size_t n = 0;
+    for (std::size_t i : x.train) n += pos[i];
+    return n;
+  };
+  std::vector<std::size_t> previous;
+  for (std::size_t n : {1u, 4u, 8u, 12u, 17u}) {
+    const Fold s = learningPositivesFold(f, pos, n, 7);
+    EXPECT_EQ(s.test, f.test);
+    EXPECT_TRUE(std::is_sorted(s.train.begin(), s.train.end()));
+    EXPECT_GE(held(s), n);
+    for (std::size_t i : s.train) EXPECT_GE(i, 2u);  // training items only
+    // Nested: the smaller subset's items are all here.
+    for (std::size_t i : previous) EXPECT_NE(std::find(s.train.begin(), s.train.end(), i), s.train.end());
+    previous = s.train;
+    EXPECT_EQ(learningPositivesFold(f, pos, n, 7).train, s.train);  // seeded
+  }
+  // The minimal-prefix rule checked by replaying the shuffle's order: the items of the n = 1
+  // subset hold at least one positive, and all but one of them hold none.
+  const Fold one = learningPositivesFold(f, pos, 1, 7);
+  std::size_t withPositives = 0;
+  for (std::size_t i : one.train) withPositives += pos[i] > 0 ? 1 : 0;
+  EXPECT_EQ(withPositives, 1u);
+  EXPECT_EQ(learningPositivesFold(f, pos, 18, 7).train, f.train);  // exactly all
+  EXPECT_EQ(learningPositivesFold(f, pos, 99, 7).train, f.train);
+  EXPECT_EQ(learningPositivesFold(f, pos, 0, 7).train, f.train);   // 0 = all
+  bool anotherSeedDiffers = false;
+  for (std::uint64_t seed = 1; seed < 20; ++seed)
+    anotherSeedDiffers |= learningPositivesFold(f, pos, 4, seed).train != learningPositivesFold(f, pos, 4, 7).train;
+  EXPECT_TRUE(anotherSeedDiffers);
+  // The drive curve's shuffle is not changed by the positives' one (cached fold models stay valid).
+  const Fold drives = learningCurveFold(f, g, 1, 3);
+  EXPECT_EQ(trainingGroupCount(drives, g), 1u);
+}
+
+// Positives, drives and distinct objects of a fold's training items, counted by hand: item 0
+// (drive d1) holds a car of track 3 and a car of track 4 too small to be a positive (20 px);
+// item 1 (d1) track 3 again and a car without a track (an object-benchmark label); item 2 (d2)
+// a van and a DontCare; item 3 (held out) a car.
+TEST(LearningCurve, PositivesDrivesAndDistinctObjects) {
+  MatchConfig m;
+  m.className = "car";
+  const auto car = [](double h) { return label("car", "Car", {0, 0, 40, h}); };
+  const std::vector<Labels> labels = {{car(40), car(20)},
+                                      {car(50), car(30)},
+                                      {label("van", "Van", {0, 0, 40, 40}), label("DontCare", "DontCare", {0, 0, 9, 9}, true)},
+                                      {car(60)}};
+  const std::vector<std::string> drive = {"d1", "d1", "d2", "d3"};
+  const std::vector<std::vector<std::string>> objects = {{"d1/track 3", "d1/track 4"}, {"d1/track 3"}, {}, {"x"}};
+  EXPECT_EQ(positivesPerItem(labels, m), (std::vector<std::size_t>{1, 2, 0, 1}));
+  Fold f;
+  f.train = {0, 1, 2};
+  f.test = {3};
+  const TrainingSetCount c = countTrainingSet(f, labels, drive, objects, m);
+  EXPECT_EQ(c.items, 3u);
+  EXPECT_EQ(c.positives, 3u);  // 40, 50 and 30 px cars; the 20 px one is below moderate
+  EXPECT_EQ(c.groups, 2u);     // d1, d2
+  EXPECT_EQ(c.objects, 2u);    // track 3 (twice) + the unnamed 30 px car; track 4 is the ignored one
+  Fold none;
+  EXPECT_EQ(countTrainingSet(none, labels, drive, objects, m).objects, 0u);
+  f.train = {9};
+  EXPECT_THROW(countTrainingSet(f, labels, drive, objects, m), std::out_of_range);
 }
 
 TEST(DataSplit, SplitByFrameWithTrainOnlyGroups) {

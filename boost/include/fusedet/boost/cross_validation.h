@@ -61,6 +61,10 @@ struct CrossValidationResult {
   // parts) count it once when a run sums these, and a model trained earlier in the same run is
   // not counted again as cached.
   std::map<std::string, FoldModel> models;
+  // With ChainSpec::scoreTrainingItems: one outcome per (fold, training item), folds in order and
+  // each fold's training items in ascending order; an item trains in several folds, so it appears
+  // once per fold. An untrained fold detects nothing on its training items either.
+  std::vector<FrameOutcome> trainingFrames;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -69,6 +73,10 @@ struct ChainSpec {
   // > 0: each part is evaluated cut to its first `keepStages` stages (firstStages(): the cascade
   // training with that stage limit gives), so one trained (cached) model serves every stage count.
   std::size_t keepStages = 0;
+  // Also run each fold's chain on its OWN training items (same detection, same KITTI rules, the
+  // items' labels as the test items hold them): the training score beside the held-out one that
+  // tells a data limit (high on training, low held out) from a method limit (low on both).
+  bool scoreTrainingItems = false;
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the

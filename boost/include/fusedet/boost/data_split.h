@@ -5,8 +5,10 @@
 //    one drive share the same physical objects, so this measures little about a new street.
 //  - crossGroupFolds: leave-one-group-out (every group, i.e. raw drive, is the test set once,
 //    trained on all others), or groups dealt into k folds for a cheaper run.
-//  - learningCurveGroups: a seeded subset of a fold's training groups (F against the number of
+//  - learningCurveFold: a seeded subset of a fold's training groups (F against the number of
 //    training drives).
+//  - learningPositivesFold: a seeded subset of a fold's training items (frames) holding at least N
+//    positives of a class (F against the number of training positives: drives are very unequal).
 
 #include <cstddef>
 #include <cstdint>
@@ -48,6 +50,14 @@ std::vector<Fold> crossGroupFolds(const std::vector<std::string>& groupOfItem, s
 // groups >= the fold's training groups returns the fold unchanged.
 Fold learningCurveFold(const Fold& fold, const std::vector<std::string>& groupOfItem, std::size_t groups,
                        std::uint64_t seed);
+
+// A fold restricted to a seeded random subset of its training items: one shuffle of them per
+// (seed, fold), taken from the front until the items hold at least `minPositives` positives
+// (positivesOfItem[i] = positives of the class in item i). Prefixes of one shuffle, so a larger
+// count keeps the smaller one's items (nested). minPositives = 0, or more than the fold's training
+// items hold, returns the fold unchanged. Training items stay in ascending order.
+Fold learningPositivesFold(const Fold& fold, const std::vector<std::size_t>& positivesOfItem,
+                           std::size_t minPositives, std::uint64_t seed);
 
 // Number of distinct groups among the fold's training items.
 std::size_t trainingGroupCount(const Fold& fold, const std::vector<std::string>& groupOfItem);

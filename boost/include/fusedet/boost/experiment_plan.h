@@ -9,10 +9,12 @@
 //    paper's configurations (no_corners, laser, camera, and) and `channels`, which run for car
 //    only (person and bike have too few positives for a comparison to say anything:
 //    docs/results); learning curves of `all` (1, 2, 4, 8 and all training drives) on 3
-//    drive-disjoint folds, because 22 leave-one-drive-out folds per point are about 7x as many trainings.
+//    drive-disjoint folds, because 22 leave-one-drive-out folds per point are about 7x as many trainings;
+//    the same curve over 8, 16, 32, 64, 128 and all training positives per fold; every point
+//    scored on its own training frames too.
 //  - "quick": the same plan scaled down to a smoke test of a minute or two (grid 6, at most 4
 //    stages of 5 stumps, coarse scans, 3 drive-disjoint folds, 200 resamples, configurations
-//    without `channels`, a two-point learning curve); its numbers mean little.
+//    without `channels`, two-point learning curves over drives and positives); its numbers mean little.
 //
 // Options of `fusedet experiments` override single fields; the plan is the default.
 
@@ -45,7 +47,14 @@ struct ExperimentPlan {
   // Learning curve of `all`: training drives per fold (0 = all of them), on `learningFolds` folds
   // (same meaning as `folds`; the `all` point reuses the headline when both fold designs agree).
   std::vector<std::size_t> learningDrives;
+  // The same curve over training positives of the class per fold (0 = all): a seeded nested
+  // subset of each fold's training frames grown until it holds that many (data_split.h
+  // learningPositivesFold), on the same folds.
+  std::vector<std::size_t> learningPositives;
   int learningFolds = 3;
+  // Every learning-curve point is also scored on its folds' own training frames (bias against
+  // variance: cross_validation.h ChainSpec::scoreTrainingItems).
+  bool trainingScore = true;
   double peerUpscale = 2;  // HOG people detector: images enlarged by this factor
 };
 
