@@ -152,11 +152,11 @@ std::string presets(T boosting::ExperimentPlan::*field) {
   return presets([field](const boosting::ExperimentPlan& p) { return shortNum(static_cast<double>(p.*field)); });
 }
 
-std::string learningText(const std::vector<std::size_t>& counts) {
+std::string learningText(const std::vector<std::size_t>& counts, const std::string& sep = ", ") {
   if (counts.empty()) return "none";
   std::vector<std::string> v;
   for (std::size_t k : counts) v.push_back(k == 0 ? "all" : std::to_string(k));
-  return joined(v);
+  return joined(v, sep);
 }
 
 // "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).
@@ -993,11 +993,7 @@ const bool registered = registerCommand(
              },
              "training drives per fold for the learning curve of `all` (a seeded nested subset of each "
              "fold's training drives), all = every one; none = no curve" +
-                 presets([](const boosting::ExperimentPlan& p) {
-                   std::vector<std::string> v;
-                   for (std::size_t k : p.learningDrives) v.push_back(k ? std::to_string(k) : "all");
-                   return v.empty() ? std::string("none") : joined(v, ",");
-                 }))
+                 presets([](const boosting::ExperimentPlan& p) { return learningText(p.learningDrives, ","); }))
           ->delimiter(',');
       app.add_option_function<std::vector<std::string>>(
              "--learning-positives",
@@ -1009,11 +1005,7 @@ const bool registered = registerCommand(
              "a seeded nested random subset of each fold's training frames, taken until it holds at least N "
              "moderate positives (the report records the exact positives, distinct objects - a KITTI tracking "
              "id counts once -, drives and frames per fold); all = every training frame; none = no curve" +
-                 presets([](const boosting::ExperimentPlan& p) {
-                   std::vector<std::string> v;
-                   for (std::size_t k : p.learningPositives) v.push_back(k ? std::to_string(k) : "all");
-                   return v.empty() ? std::string("none") : joined(v, ",");
-                 }))
+                 presets([](const boosting::ExperimentPlan& p) { return learningText(p.learningPositives, ","); }))
           ->delimiter(',');
       app.add_flag_callback(
           "--no-training-score", [o] { o->trainingScore = false; },
