@@ -76,6 +76,9 @@ struct ExperimentOptions {
   double scaleFactor = 0;
   double step = 0;
   int minNeighbors = 3;
+  std::string grouping = "opencv";  // opencv | nms (boosting::GroupParams)
+  double nmsIou = 0.5;
+  int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -88,6 +91,7 @@ struct ExperimentOptions {
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
   std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to
   std::vector<int> neighborsSweep;                 // min neighbours of that sweep (default: --min-neighbors)
+  bool missAnalysis = true;                        // explain every missed positive of `all`
   std::string commandLine;
 };
 
@@ -303,6 +307,25 @@ boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   return p;
 }
 
+// Grouping of the raw hits, as the options give it (fusedetd's detection.* keys mean the same).
+boosting::GroupParams groupParams(const ExperimentOptions& o) {
+  boosting::GroupParams g;
+  g.method = o.grouping == "nms" ? boosting::GroupParams::Method::kNms : boosting::GroupParams::Method::kOpenCv;
+  g.minNeighbors = o.minNeighbors;
+  g.iouThreshold = o.nmsIou;
+  g.smallHeight = o.smallHeight;
+  g.smallMinNeighbors = o.smallMinNeighbors;
+  return g;
+}
+
+std::string groupingText(const ExperimentOptions& o) {
+  if (o.grouping == "nms") return "non-maximum suppression by last stage sum, IoU > " + shortNum(o.nmsIou);
+  std::string t = "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors);
+  if (o.smallHeight > 0)
+    t += " (" + std::to_string(o.smallMinNeighbors) + " for groups lower than " + std::to_string(o.smallHeight) + " px)";
+  return t;
+}
+
 boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosting::ExperimentPlan& p, const std::string& cls,
                                         const TrainedConfig& tc, const boosting::MatchConfig& match) {
   boosting::TrainingConfig c;
@@ -330,7 +353,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.part = p.validationPart;
   c.validation.detection.scan.scaleFactor = p.scaleFactor;
   c.validation.detection.scan.step = p.step;
-  c.validation.detection.group.minNeighbors = o.minNeighbors;
+  c.validation.detection.group = groupParams(o);
   c.validation.match = match;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
@@ -544,7 +567,7 @@ int runExperiments(ExperimentOptions o) {
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
   setup.scan.threads = 1;  // ms per stack on one core, comparable across configurations
-  setup.group.minNeighbors = o.minNeighbors;
+  setup.group = groupParams(o);
 
   report.settings = {
       {"preset", preset.name},
@@ -575,7 +598,7 @@ int runExperiments(ExperimentOptions o) {
       {"bootstrap resamples", std::to_string(preset.resamples)},
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
       {"training scan scale factor / step", shortNum(preset.trainScaleFactor) + " / " + shortNum(preset.trainStep)},
-      {"grouping", "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors)},
+      {"grouping", groupingText(o)},
       {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
@@ -703,9 +726,13 @@ int runExperiments(ExperimentOptions o) {
   const auto runConfig = [&](const std::string& cls, const std::string& config) {
     const boosting::MatchConfig match = matchFor(cls);
     std::printf("%s / %s:\n", cls.c_str(), config.c_str());
-    const boosting::ChainSpec spec = chainFor(o, preset, cls, config, match);
+    boosting::ChainSpec spec = chainFor(o, preset, cls, config, match);
+    spec.analyseMisses = o.missAnalysis && config == "all";
     const boosting::CrossValidationResult cv =
         boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, setup, cache, quiet, log);
+    if (spec.analyseMisses)
+      report.misses.push_back({cls, config, boosting::summariseMisses(cv.positives), boosting::MissAnalysisConfig{}.localisationIou,
+                               setup.group.minNeighbors});
     ConfigResult r;
     r.className = cls;
     r.config = config;
@@ -1049,6 +1076,24 @@ const bool registered = registerCommand(
                      "detection position step in base-window pixels" +
                          presets(&boosting::ExperimentPlan::step));
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
+      app.add_option("--grouping", o->grouping,
+                     "grouping of raw hits: opencv (cv::groupRectangles' rule, score = group size) or nms "
+                     "(score-based non-maximum suppression, score = last stage sum), as fusedetd's detection.grouping")
+          ->check(CLI::IsMember({"opencv", "nms"}))
+          ->capture_default_str();
+      app.add_option("--nms-iou", o->nmsIou, "--grouping nms: a hit overlapping a kept one with IoU above this is dropped")
+          ->check(CLI::Range(0.0, 1.0))
+          ->capture_default_str();
+      app.add_option("--small-height", o->smallHeight,
+                     "--grouping opencv: groups lower than this many pixels need more than --small-min-neighbors "
+                     "hits instead of --min-neighbors (a small object is covered by fewer scanned windows); 0 = off, "
+                     "as fusedetd's detection.small_height")
+          ->check(CLI::Range(0, 100000))
+          ->capture_default_str();
+      app.add_option("--small-min-neighbors", o->smallMinNeighbors,
+                     "--grouping opencv with --small-height: hits a group lower than that height needs (more than)")
+          ->check(CLI::Range(0, 1000))
+          ->capture_default_str();
       app.add_option("--contrast-normalise", o->contrastNormalise,
                      "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
                      "window's standard deviation of their layer): none, camera (red, green, blue, intensity "
@@ -1096,6 +1141,13 @@ const bool registered = registerCommand(
                      "min neighbours the stage sweep groups with, e.g. 1,2,3 (default: --min-neighbors)")
           ->delimiter(',')
           ->check(CLI::Range(0, 1000));
+      app.add_flag("!--no-miss-analysis", o->missAnalysis,
+                   "skip the miss analysis: by default every positive the `all` configuration misses is classified "
+                   "by the step that lost it - scan geometry (no scanned window reaches IoU 0.5), cascade (every "
+                   "such window rejected; at which stage), grouping (accepted, then dropped or merged), localisation "
+                   "(a detection overlaps it with IoU >= 0.3) - with counts by height, aspect, occlusion and "
+                   "truncation (report section \"Where the missed positives are lost\"; one more detection pass "
+                   "over the test frames)");
       app.add_option("--min-positives", o->minPositives,
                      "training ends when fewer positives than this are still accepted (person data is scarce)")
           ->capture_default_str();

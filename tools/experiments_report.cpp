@@ -301,6 +301,71 @@ std::string renderMarkdown(const ExperimentReport& r) {
           body);
   }
 
+  if (!r.misses.empty()) {
+    md << "## Where the missed positives are lost\n\n"
+          "Every positive of the `all` configuration's held-out frames that no detection hits, classified by the "
+          "first step that lost it (boosting::analyseMisses, miss_analysis.h): **scan geometry** - no window the "
+          "scan visits (window aspect, minimum size, scale step, position step, image border) reaches IoU >= 0.5 "
+          "with it; **grouping** - a window with IoU >= 0.5 is accepted by the cascade but grouping drops it (too "
+          "few neighbours, inside a bigger group) or merges it into a detection that misses the object; "
+          "**localisation** - no such window is accepted, but a detection overlaps the object with IoU >= the "
+          "localisation limit (badly placed: also a false alarm); **cascade** - every window with IoU >= 0.5 is "
+          "rejected by the cascade.\n\n";
+    for (const MissResult& m : r.misses) {
+      const boosting::MissBreakdown& b = m.breakdown;
+      char head[256];
+      std::snprintf(head, sizeof head, "%s / %s: %zu of %zu positives missed (min neighbours %d, localisation IoU >= %.2f)",
+                    m.className.c_str(), m.config.c_str(), b.allMisses, b.allPositives, m.minNeighbors,
+                    m.localisationIou);
+      md << "### " << head << "\n\n";
+      std::vector<std::vector<std::string>> body;
+      for (boosting::MissCause c : boosting::kMissCauses) {
+        const std::size_t k = static_cast<std::size_t>(c);
+        if (c == boosting::MissCause::kUntrained && b.total[k] == 0) continue;
+        char share[32];
+        std::snprintf(share, sizeof share, "%.0f %%", b.allMisses ? 100.0 * double(b.total[k]) / double(b.allMisses) : 0.0);
+        body.push_back({boosting::missCauseName(c), std::to_string(b.total[k]), share, std::to_string(b.nearDetection[k])});
+      }
+      table(md, {"cause", "misses", "share of misses", "of them with a detection at IoU >= the localisation limit"},
+            body);
+      body.clear();
+      for (std::size_t k = 0; k < b.bucketNames.size(); ++k) {
+        std::vector<std::string> row{b.bucketGroup[k] + ": " + b.bucketNames[k], std::to_string(b.positives[k]),
+                                     std::to_string(b.misses[k])};
+        char recall[32];
+        if (b.positives[k] > 0)
+          std::snprintf(recall, sizeof recall, "%.2f", double(b.positives[k] - b.misses[k]) / double(b.positives[k]));
+        else
+          std::snprintf(recall, sizeof recall, "null");
+        row.emplace_back(recall);
+        for (boosting::MissCause c : boosting::kMissCauses)
+          if (c != boosting::MissCause::kUntrained || b.total[static_cast<std::size_t>(c)] > 0)
+            row.push_back(std::to_string(b.byCause[static_cast<std::size_t>(c)][k]));
+        body.push_back(std::move(row));
+      }
+      std::vector<std::string> header{"objects", "positives", "misses", "recall"};
+      for (boosting::MissCause c : boosting::kMissCauses)
+        if (c != boosting::MissCause::kUntrained || b.total[static_cast<std::size_t>(c)] > 0)
+          header.push_back(boosting::missCauseName(c));
+      table(md, header, body);
+      md << "Grouping losses:";
+      for (std::size_t g = 1; g < b.groupingLosses.size(); ++g)
+        md << (g > 1 ? "," : "") << " " << boosting::groupingLossName(static_cast<boosting::GroupingLoss>(g)) << " "
+           << b.groupingLosses[g];
+      md << ". Too few neighbours, by the largest group an accepted window with IoU >= 0.5 fell in:";
+      for (std::size_t g = 0; g < b.tooFewByGroupSize.size(); ++g)
+        if (b.tooFewByGroupSize[g] > 0) md << " " << g << " member" << (g == 1 ? "" : "s") << ": " << b.tooFewByGroupSize[g] << ";";
+      md << " cascade misses by the stage that rejected the deepest window with IoU >= 0.5:";
+      bool any = false;
+      for (std::size_t s = 0; s < b.rejectedAtStage.size(); ++s)
+        if (b.rejectedAtStage[s] > 0) {
+          md << (any ? "," : "") << " stage " << s + 1 << ": " << b.rejectedAtStage[s];
+          any = true;
+        }
+      md << (any ? ".\n\n" : " none.\n\n");
+    }
+  }
+
   const auto weightShares = [&](const std::string& config, const std::string& heading) {
     std::vector<const ConfigResult*> results;
     std::map<std::string, double> allLayers;
@@ -446,6 +511,29 @@ json toJson(const ExperimentReport& r) {
                                 {"f_measure", estimateJson(p.f)}, {"average_precision", estimateJson(p.ap)},
                                 {"hits", p.counts.hits}, {"false_alarms", p.counts.falseAlarms},
                                 {"misses", p.counts.misses}});
+  j["miss_analysis"] = json::array();
+  for (const MissResult& m : r.misses) {
+    const boosting::MissBreakdown& b = m.breakdown;
+    json causes = json::object(), buckets = json::array(), grouping = json::object();
+    for (boosting::MissCause c : boosting::kMissCauses) {
+      const std::size_t k = static_cast<std::size_t>(c);
+      causes[boosting::missCauseName(c)] = {{"misses", b.total[k]}, {"with_near_detection", b.nearDetection[k]}};
+    }
+    for (std::size_t k = 0; k < b.bucketNames.size(); ++k) {
+      json byCause = json::object();
+      for (boosting::MissCause c : boosting::kMissCauses)
+        byCause[boosting::missCauseName(c)] = b.byCause[static_cast<std::size_t>(c)][k];
+      buckets.push_back({{"group", b.bucketGroup[k]}, {"bucket", b.bucketNames[k]}, {"positives", b.positives[k]},
+                         {"misses", b.misses[k]}, {"by_cause", byCause}});
+    }
+    for (std::size_t g = 1; g < b.groupingLosses.size(); ++g)
+      grouping[boosting::groupingLossName(static_cast<boosting::GroupingLoss>(g))] = b.groupingLosses[g];
+    j["miss_analysis"].push_back({{"class", m.className}, {"config", m.config}, {"positives", b.allPositives},
+                                  {"misses", b.allMisses}, {"min_neighbors", m.minNeighbors},
+                                  {"localisation_iou", m.localisationIou}, {"causes", causes}, {"buckets", buckets},
+                                  {"grouping_losses", grouping}, {"cascade_rejected_at_stage", b.rejectedAtStage},
+                                  {"too_few_neighbours_by_group_size", b.tooFewByGroupSize}});
+  }
   j["goals"] = json::array();
   for (const Goal& g : r.goals)
     j["goals"].push_back({{"class", g.className}, {"goal", g.text}, {"target", g.target},

@@ -16,6 +16,7 @@
 #include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/learning_curve.h"
+#include "fusedet/boost/miss_analysis.h"
 #include "fusedet/boost/precision_recall.h"
 
 namespace fusedet::tools::experiments {
@@ -85,6 +86,14 @@ struct SweepPoint {
   Estimate f, ap;
 };
 
+// Where a configuration's missed positives were lost (boosting::summariseMisses over all folds).
+struct MissResult {
+  std::string className, config;
+  boosting::MissBreakdown breakdown;
+  double localisationIou = 0.3;
+  int minNeighbors = 3;
+};
+
 struct ClassCounts {
   std::string className;
   std::size_t positives = 0, ignoredLabels = 0, frames = 0, drivesWithPositives = 0;
@@ -111,6 +120,7 @@ struct ExperimentReport {
   std::vector<LearningPoint> learning;
   std::string learningFolds;  // the learning curve's fold design, e.g. "3 drive-disjoint folds"
   std::vector<SweepPoint> sweep;
+  std::vector<MissResult> misses;
   std::vector<Goal> goals;
   std::map<std::string, std::string> settings;  // shown in a table and in results.json
   std::vector<std::string> notes;               // facts the run wants the reader to know

@@ -47,7 +47,10 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
       << v.maxCascadeFalseAlarm << " scan " << v.detection.scan.scaleFactor << " " << v.detection.scan.step << " "
       << v.detection.scan.minWidth << " " << v.detection.scan.minHeight << " group "
       << static_cast<int>(v.detection.group.method) << " " << v.detection.group.minNeighbors << " "
-      << v.detection.group.eps << " " << v.detection.group.iouThreshold << " match " << v.match.className << " "
+      << v.detection.group.eps << " " << v.detection.group.iouThreshold;
+    if (v.detection.group.smallHeight > 0)  // only then: earlier keys stay as they were
+      d << " small " << v.detection.group.smallHeight << " " << v.detection.group.smallMinNeighbors;
+    d << " match " << v.match.className << " "
       << v.match.minIou << " " << v.match.minHeight << " " << v.match.maxOcclusion << " " << v.match.maxTruncation
       << " " << v.match.minDetectionHeight << " aliases " << joined(v.match.aliasClasses) << " neighbours "
       << joined(v.match.neighbourClasses) << " ignore " << joined(v.match.ignoreClasses) << "\n";
@@ -113,8 +116,11 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
   if (spec.parts.empty()) throw std::invalid_argument("crossValidate: no training configuration");
   if (trainingItems.size() != testItems.size())
     throw std::invalid_argument("crossValidate: training and test items differ in number");
+  if (spec.analyseMisses && spec.parts.size() != 1)
+    throw std::invalid_argument("crossValidate: the miss analysis needs a chain of one cascade");
   CrossValidationResult out;
   out.frames.resize(testItems.size());
+  if (spec.analyseMisses) out.positives.resize(testItems.size());
   double detectMs = 0;
   std::size_t detected = 0;
   for (const Fold& fold : folds) {
@@ -142,7 +148,10 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     } catch (const std::runtime_error& e) {
       out.failures.push_back("fold " + name + ": " + e.what());
       if (log) log("fold " + shortName + ": not trained (counted as detecting nothing): " + e.what());
-      for (std::size_t i : fold.test) out.frames[i] = frameOutcome({}, matchDetections({}, testItems[i].labels, match));
+      for (std::size_t i : fold.test) {
+        out.frames[i] = frameOutcome({}, matchDetections({}, testItems[i].labels, match));
+        if (spec.analyseMisses) out.positives[i] = untrainedOutcomes(testItems[i].labels, match);
+      }
       if (spec.scoreTrainingItems)
         for (std::size_t i : fold.train)
           out.trainingFrames.push_back(frameOutcome({}, matchDetections({}, testItems[i].labels, match)));
@@ -152,6 +161,15 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     for (const Detector& d : detectors) chain.push_back(&d);
     const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, setup);
     for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
+    if (spec.analyseMisses)
+      for (std::size_t k = 0; k < fold.test.size(); ++k) {
+        const DatasetItem& item = testItems[fold.test[k]];
+        FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, setup);
+        if (a.match.hits != eval.matches[k].hits || a.match.falseAlarms != eval.matches[k].falseAlarms)
+          throw std::logic_error("crossValidate: the miss analysis detected differently from the evaluation on " +
+                                 item.id);
+        out.positives[fold.test[k]] = std::move(a.positives);
+      }
     out.summaries.push_back(parts.size() == 1 ? parts.front() : combineSummaries(parts));
     detectMs += eval.msPerStack * static_cast<double>(fold.test.size());
     detected += fold.test.size();

@@ -43,10 +43,14 @@ Detection makeDetection(const Box& box, double score, const std::string& classNa
 }
 
 std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupParams& p, const std::string& cls,
-                                   const LayerStack& stack) {
+                                   const LayerStack& stack, std::vector<HitFate>& fates) {
   std::vector<Detection> out;
+  fates.assign(hits.size(), HitFate{});
   if (p.minNeighbors <= 0) {
-    for (const RawHit& h : hits) out.push_back(makeDetection(h.box, 1, cls, stack));
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      fates[i].detection = static_cast<int>(i);
+      out.push_back(makeDetection(hits[i].box, 1, cls, stack));
+    }
     return out;
   }
   const int n = static_cast<int>(hits.size());
@@ -95,26 +99,43 @@ std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupPara
     auto rnd = [s](long long v) { return static_cast<int>(std::lrintf(static_cast<float>(v) * s)); };
     avg[c] = {rnd(sums[c][0]), rnd(sums[c][1]), rnd(sums[c][2]), rnd(sums[c][3])};
   }
+  // Members a group needs more than: minNeighbors, or smallMinNeighbors for groups lower than
+  // smallHeight (off by default, which is cv::groupRectangles' rule).
+  const auto needs = [&](std::size_t c) {
+    return p.smallHeight > 0 && avg[c].h < p.smallHeight ? p.smallMinNeighbors : p.minNeighbors;
+  };
+  std::vector<HitFate> classFate(avg.size());
   for (std::size_t i = 0; i < avg.size(); ++i) {
     const IRect& r1 = avg[i];
     const int n1 = count[i];
-    if (n1 <= p.minNeighbors) continue;
+    classFate[i].groupSize = n1;
+    if (n1 <= needs(i)) {
+      classFate[i].outcome = HitFate::Outcome::kTooFewNeighbours;
+      continue;
+    }
     bool inside = false;
     for (std::size_t j = 0; j < avg.size() && !inside; ++j) {
       const int n2 = count[j];
-      if (j == i || n2 <= p.minNeighbors) continue;
+      if (j == i || n2 <= needs(j)) continue;
       const IRect& r2 = avg[j];
       const int dx = static_cast<int>(std::lrint(r2.w * p.eps)), dy = static_cast<int>(std::lrint(r2.h * p.eps));
       inside = r1.x >= r2.x - dx && r1.y >= r2.y - dy && r1.x + r1.w <= r2.x + r2.w + dx &&
                r1.y + r1.h <= r2.y + r2.h + dy && (n2 > std::max(3, n1) || n1 < 3);
     }
-    if (!inside) out.push_back(makeDetection(Box{double(r1.x), double(r1.y), double(r1.w), double(r1.h)}, n1, cls, stack));
+    if (inside) {
+      classFate[i].outcome = HitFate::Outcome::kInsideBiggerGroup;
+      continue;
+    }
+    classFate[i].detection = static_cast<int>(out.size());
+    out.push_back(makeDetection(Box{double(r1.x), double(r1.y), double(r1.w), double(r1.h)}, n1, cls, stack));
   }
+  for (std::size_t i = 0; i < hits.size(); ++i) fates[i] = classFate[static_cast<std::size_t>(label[i])];
   return out;
 }
 
 std::vector<Detection> groupNms(std::span<const RawHit> hits, const GroupParams& p, const std::string& cls,
-                                const LayerStack& stack) {
+                                const LayerStack& stack, std::vector<HitFate>& fates) {
+  fates.assign(hits.size(), HitFate{});
   std::vector<std::size_t> order(hits.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return hits[a].score > hits[b].score; });
@@ -122,12 +143,14 @@ std::vector<Detection> groupNms(std::span<const RawHit> hits, const GroupParams&
   std::vector<Box> kept;
   for (std::size_t i : order) {
     bool suppressed = false;
-    for (const Box& k : kept)
-      if (iou(hits[i].box, k) > p.iouThreshold) {
+    for (std::size_t k = 0; k < kept.size(); ++k)
+      if (iou(hits[i].box, kept[k]) > p.iouThreshold) {
         suppressed = true;
+        fates[i] = {HitFate::Outcome::kSuppressed, static_cast<int>(k), 1};
         break;
       }
     if (suppressed) continue;
+    fates[i].detection = static_cast<int>(out.size());
     kept.push_back(hits[i].box);
     out.push_back(makeDetection(hits[i].box, hits[i].score, cls, stack));
   }
@@ -137,9 +160,11 @@ std::vector<Detection> groupNms(std::span<const RawHit> hits, const GroupParams&
 }  // namespace
 
 std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams& params, const std::string& className,
-                                 const LayerStack& stack) {
-  return params.method == GroupParams::Method::kNms ? groupNms(hits, params, className, stack)
-                                                    : groupOpenCv(hits, params, className, stack);
+                                 const LayerStack& stack, std::vector<HitFate>* fates) {
+  std::vector<HitFate> local;
+  std::vector<HitFate>& f = fates ? *fates : local;
+  return params.method == GroupParams::Method::kNms ? groupNms(hits, params, className, stack, f)
+                                                    : groupOpenCv(hits, params, className, stack, f);
 }
 
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,

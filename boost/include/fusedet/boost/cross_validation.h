@@ -21,6 +21,7 @@
 #include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/data_split.h"
 #include "fusedet/boost/evaluation.h"
+#include "fusedet/boost/miss_analysis.h"
 #include "fusedet/core/dataset.h"
 
 namespace fusedet::boosting {
@@ -65,6 +66,8 @@ struct CrossValidationResult {
   // each fold's training items in ascending order; an item trains in several folds, so it appears
   // once per fold. An untrained fold detects nothing on its training items either.
   std::vector<FrameOutcome> trainingFrames;
+  // Per item, what became of each positive (ChainSpec::analyseMisses, one-cascade chains only).
+  std::vector<std::vector<PositiveOutcome>> positives;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -77,6 +80,9 @@ struct ChainSpec {
   // items' labels as the test items hold them): the training score beside the held-out one that
   // tells a data limit (high on training, low held out) from a method limit (low on both).
   bool scoreTrainingItems = false;
+  // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives;
+  // needs a chain of one cascade.
+  bool analyseMisses = false;
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the

@@ -23,13 +23,33 @@ struct GroupParams {
   enum class Method { kOpenCv, kNms };
   Method method = Method::kOpenCv;
   int minNeighbors = 3;        // kOpenCv
+  // kOpenCv: groups whose box is lower than smallHeight pixels need more than smallMinNeighbors
+  // members instead (a small object is covered by fewer scanned windows: no smaller scales lie
+  // below the minimum size). smallHeight 0 = off (cv::groupRectangles' rule).
+  int smallHeight = 0;
+  int smallMinNeighbors = 1;
   double eps = 0.2;            // kOpenCv (OpenCV's GROUP_EPS)
   double iouThreshold = 0.5;   // kNms
 };
 
+// What became of one raw hit (miss_analysis.h asks): the detection it went into, or why none.
+struct HitFate {
+  enum class Outcome {
+    kKept,               // part of a group (or NMS's kept hit) that became output detection `detection`
+    kTooFewNeighbours,   // kOpenCv: its group had <= minNeighbors members
+    kInsideBiggerGroup,  // kOpenCv: its group lay inside a bigger, better supported one
+    kSuppressed,         // kNms: a higher-scored hit with IoU > iouThreshold was kept (`detection`)
+  };
+  Outcome outcome = Outcome::kKept;
+  int detection = -1;  // index into groupHits()' output, -1 when the hit went into none
+  int groupSize = 1;   // members of its group (kOpenCv), else 1
+};
+
 // Detections for `className` in `stack` (boxes in its reference pixels, unitBox, stamp, stackId).
+// `fates` (optional) gets one entry per hit; the detections are the same with or without it.
 std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams& params,
-                                 const std::string& className, const LayerStack& stack);
+                                 const std::string& className, const LayerStack& stack,
+                                 std::vector<HitFate>* fates = nullptr);
 
 // Scan + group in one call.
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
