@@ -732,7 +732,7 @@ int runExperiments(ExperimentOptions o) {
         boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, setup, cache, quiet, log);
     if (spec.analyseMisses)
       report.misses.push_back({cls, config, boosting::summariseMisses(cv.positives), boosting::MissAnalysisConfig{}.localisationIou,
-                               setup.group.minNeighbors});
+                               setup.group.minNeighbors, match.minIou});
     ConfigResult r;
     r.className = cls;
     r.config = config;

@@ -304,18 +304,19 @@ std::string renderMarkdown(const ExperimentReport& r) {
   if (!r.misses.empty()) {
     md << "## Where the missed positives are lost\n\n"
           "Every positive of the `all` configuration's held-out frames that no detection hits, classified by the "
-          "first step that lost it (boosting::analyseMisses, miss_analysis.h): **scan geometry** - no window the "
-          "scan visits (window aspect, minimum size, scale step, position step, image border) reaches IoU >= 0.5 "
-          "with it; **grouping** - a window with IoU >= 0.5 is accepted by the cascade but grouping drops it (too "
-          "few neighbours, inside a bigger group) or merges it into a detection that misses the object; "
-          "**localisation** - no such window is accepted, but a detection overlaps the object with IoU >= the "
-          "localisation limit (badly placed: also a false alarm); **cascade** - every window with IoU >= 0.5 is "
-          "rejected by the cascade.\n\n";
+          "first step that lost it (boosting::analyseMisses, miss_analysis.h), with the class's hit overlap "
+          "(IoU below): **scan geometry** - no window the scan visits (window aspect, minimum size, scale step, "
+          "position step, image border) reaches that IoU with it; **grouping** - such a window is accepted by the "
+          "cascade but grouping drops it (too few neighbours, inside a bigger group) or merges it into a detection "
+          "that misses the object; **localisation** - no such window is accepted, but a detection overlaps the "
+          "object with IoU >= the localisation limit (badly placed: also a false alarm); **cascade** - every such "
+          "window is rejected by the cascade.\n\n";
     for (const MissResult& m : r.misses) {
       const boosting::MissBreakdown& b = m.breakdown;
       char head[256];
-      std::snprintf(head, sizeof head, "%s / %s: %zu of %zu positives missed (min neighbours %d, localisation IoU >= %.2f)",
-                    m.className.c_str(), m.config.c_str(), b.allMisses, b.allPositives, m.minNeighbors,
+      std::snprintf(head, sizeof head,
+                    "%s / %s: %zu of %zu positives missed (hit IoU >= %.2f, min neighbours %d, localisation IoU >= %.2f)",
+                    m.className.c_str(), m.config.c_str(), b.allMisses, b.allPositives, m.minIou, m.minNeighbors,
                     m.localisationIou);
       md << "### " << head << "\n\n";
       std::vector<std::vector<std::string>> body;
@@ -352,10 +353,12 @@ std::string renderMarkdown(const ExperimentReport& r) {
       for (std::size_t g = 1; g < b.groupingLosses.size(); ++g)
         md << (g > 1 ? "," : "") << " " << boosting::groupingLossName(static_cast<boosting::GroupingLoss>(g)) << " "
            << b.groupingLosses[g];
-      md << ". Too few neighbours, by the largest group an accepted window with IoU >= 0.5 fell in:";
+      char iouText[32];
+      std::snprintf(iouText, sizeof iouText, "IoU >= %.2f", m.minIou);
+      md << ". Too few neighbours, by the largest group an accepted window with " << iouText << " fell in:";
       for (std::size_t g = 0; g < b.tooFewByGroupSize.size(); ++g)
         if (b.tooFewByGroupSize[g] > 0) md << " " << g << " member" << (g == 1 ? "" : "s") << ": " << b.tooFewByGroupSize[g] << ";";
-      md << " cascade misses by the stage that rejected the deepest window with IoU >= 0.5:";
+      md << " cascade misses by the stage that rejected the deepest window with " << iouText << ":";
       bool any = false;
       for (std::size_t s = 0; s < b.rejectedAtStage.size(); ++s)
         if (b.rejectedAtStage[s] > 0) {
@@ -530,7 +533,7 @@ json toJson(const ExperimentReport& r) {
       grouping[boosting::groupingLossName(static_cast<boosting::GroupingLoss>(g))] = b.groupingLosses[g];
     j["miss_analysis"].push_back({{"class", m.className}, {"config", m.config}, {"positives", b.allPositives},
                                   {"misses", b.allMisses}, {"min_neighbors", m.minNeighbors},
-                                  {"localisation_iou", m.localisationIou}, {"causes", causes}, {"buckets", buckets},
+                                  {"localisation_iou", m.localisationIou}, {"min_iou", m.minIou}, {"causes", causes}, {"buckets", buckets},
                                   {"grouping_losses", grouping}, {"cascade_rejected_at_stage", b.rejectedAtStage},
                                   {"too_few_neighbours_by_group_size", b.tooFewByGroupSize}});
   }

@@ -92,6 +92,7 @@ struct MissResult {
   boosting::MissBreakdown breakdown;
   double localisationIou = 0.3;
   int minNeighbors = 3;
+  double minIou = 0.5;  // the class's hit overlap the analysis used
 };
 
 struct ClassCounts {

@@ -84,7 +84,7 @@ std::string groupingLossName(GroupingLoss loss) {
   switch (loss) {
     case GroupingLoss::kNone: return "none";
     case GroupingLoss::kTakenElsewhere: return "its detection matched elsewhere";
-    case GroupingLoss::kMergedOffTarget: return "merged into a detection with IoU < 0.5";
+    case GroupingLoss::kMergedOffTarget: return "merged into a detection that misses the object";
     case GroupingLoss::kInsideBiggerGroup: return "group inside a bigger group";
     case GroupingLoss::kTooFewNeighbours: return "too few neighbours";
   }

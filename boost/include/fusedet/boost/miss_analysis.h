@@ -7,6 +7,7 @@
 //  - kGrouping: some such window ("candidate") is accepted by the cascade, but grouping loses it:
 //    its group is too small (<= min neighbours), lies inside a bigger group, is merged into a
 //    detection whose box misses the object (IoU < minIou), or its detection is matched elsewhere;
+//    (minIou is the class's hit overlap, MatchConfig: 0.7 for car, 0.5 for person and bike)
 //  - kLocalisation: no candidate is accepted, but a detection overlaps the object with
 //    localisationIou <= IoU < minIou (detected, badly placed: counted as a false alarm too);
 //  - kCascade: every candidate is rejected by the cascade; `deepestStage` says how far the best
