@@ -50,6 +50,7 @@ struct TrainOptions {
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
   bool softCascade = false;
+  std::string softStartWeights = "margin";
   bool vanNegative = false;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
@@ -215,6 +216,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
   c.softCascade = o.softCascade;
+  c.stage.marginStartWeights = o.softStartWeights == "margin";
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
@@ -312,7 +314,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"stop_reason", report.stopReason},
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
-  if (c.softCascade) info.emplace_back("cascade", "soft");
+  if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
                                              std::to_string(report.validationItems) + " items, " +
@@ -411,6 +413,12 @@ const bool registered = registerCommand(
                    "threshold applies to that cumulative sum; the model file records it (\"cascade\": \"soft\", "
                    "format version 3). Not with --validation-part or MPI. Default: hard cascade (every stage's sum "
                    "from 0)");
+      app.add_option("--soft-start-weights", o->softStartWeights,
+                     "with --soft-cascade: first-round weights of a stage, 'margin' = exp(-y F) of the samples' "
+                     "cumulative scores F (boosting chain), 'uniform' = each class uniform as in a hard stage (only "
+                     "the sums and thresholds carry the earlier stages)")
+          ->check(CLI::IsMember({"margin", "uniform"}))
+          ->capture_default_str();
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
                    "negative windows on them)");

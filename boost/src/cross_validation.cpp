@@ -37,7 +37,8 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << c.maxStages << " negatives " << c.negativesPerStage << " min_negatives " << c.minNegatives
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   if (c.minHeightFromPositives) d << "min_height_from_positives\n";
-  if (c.softCascade) d << "soft_cascade\n";  // only then: hard keys stay those of earlier caches
+  if (c.softCascade)  // only then: hard keys stay those of earlier caches
+    d << "soft_cascade" << (c.stage.marginStartWeights ? "" : " uniform_start_weights") << "\n";
   if (c.samples.jitterCopies > 0)
     d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
       << c.samples.jitterSeed << "\n";

@@ -48,7 +48,7 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
   std::vector<double> w(n);
   for (std::size_t i = 0; i < n; ++i)
     w[i] = i < positives ? 0.5 / double(positives) : 0.5 / double(n - positives);
-  if (!startScores.empty()) w = softStartWeights(startScores, positives);
+  if (!startScores.empty() && config.marginStartWeights) w = softStartWeights(startScores, positives);
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
   if (!startScores.empty()) score.assign(startScores.begin(), startScores.end());

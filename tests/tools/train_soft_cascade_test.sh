@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # `fusedet train --soft-cascade` end to end on a small synthetic data set: the model file says
 # "cascade": "soft" (format version 3) and its training record, `fusedet eval` runs it on the
-# scenes; a hard training of the same data has no "cascade" field;
+# scenes; --soft-start-weights uniform is recorded, an unknown value refused; a hard training of the same data has no "cascade" field;
 # --soft-cascade with a validation part is refused clearly.
 #   train_soft_cascade_test.sh FUSEDET WRITER WORKDIR
 set -euo pipefail
@@ -14,7 +14,10 @@ fail() { echo "FAIL: $*" >&2; exit 1; }
 "$fusedet" "${train[@]}" --soft-cascade --out soft.json >out.txt 2>err.txt || { cat err.txt >&2; fail "train failed"; }
 grep -q '"version": 3,' soft.json || fail "soft model is not format version 3"
 grep -q '"cascade": "soft",' soft.json || fail "soft model lacks \"cascade\": \"soft\""
-grep -q '"cascade":"soft"' soft.json || fail "soft model lacks the training record"
+grep -q '"cascade":"soft, start weights margin"' soft.json || fail "soft model lacks the training record"
+"$fusedet" "${train[@]}" --soft-cascade --soft-start-weights uniform --out uniform.json >/dev/null 2>&1 || fail "uniform training failed"
+grep -q '"cascade":"soft, start weights uniform"' uniform.json || fail "uniform model lacks its training record"
+if "$fusedet" "${train[@]}" --soft-cascade --soft-start-weights exp --out bad.json >bad.out 2>bad.err; then fail "--soft-start-weights exp accepted"; fi
 "$fusedet" "${train[@]}" --out hard.json >/dev/null 2>&1 || fail "hard training failed"
 if grep -q '"cascade"' hard.json; then fail "hard model names a cascade kind"; fi
 grep -q '"version": 1,' hard.json || fail "hard model is not version 1"

@@ -318,6 +318,9 @@ TEST(CrossValidation, TrainingKeyChangesWithConfigAndItems) {
   TrainingConfig soft = a;
   soft.softCascade = true;
   EXPECT_NE(trainingKey(a, {"x/1"}), trainingKey(soft, {"x/1"}));
+  TrainingConfig uniform = soft;
+  uniform.stage.marginStartWeights = false;
+  EXPECT_NE(trainingKey(soft, {"x/1"}), trainingKey(uniform, {"x/1"}));
 }
 
 }  // namespace

@@ -144,6 +144,15 @@ TEST(GentleBoost, SoftCascadeStageBoostsOnFromTheCumulativeScores) {
   EXPECT_EQ(r.hitRate, 1.0);
   EXPECT_EQ(r.falseAlarm, 0.5);
   EXPECT_TRUE(r.reachedFalseAlarm);
+  // Uniform start weights (StageConfig::marginStartWeights = false): each class uniform, the sums
+  // and the threshold still from F.
+  firstWeights.clear();
+  StageConfig u = c;
+  u.marginStartWeights = false;
+  const StageResult ru = boostStage(4, 2, find, u, {}, nullptr, start);
+  EXPECT_EQ(firstWeights, (std::vector<float>{0.25f, 0.25f, 0.25f, 0.25f}));
+  EXPECT_EQ(ru.threshold, r.threshold);
+  EXPECT_EQ(ru.falseAlarm, 0.5);
   // The same stage from 0 (a hard cascade): sums 1, 1, -1, -1, threshold just below 1, no false alarm.
   const StageResult hard = boostStage(4, 2, find, c);
   EXPECT_NEAR(hard.threshold, 1.0, 1e-8);

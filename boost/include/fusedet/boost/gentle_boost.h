@@ -21,6 +21,10 @@ struct StageConfig {
   int maxWeak = 100;  // rounds per stage at most
   int threads = 0;
   std::size_t refineTop = 4;
+  // Soft cascade stages (boostStage's startScores): the first round's weights exp(-y F) within
+  // each class (true, the boosting chain) or uniform within each class as in a hard stage (false:
+  // only the sums and the threshold carry the earlier stages' evidence).
+  bool marginStartWeights = true;
 };
 
 struct RoundInfo {
@@ -61,8 +65,9 @@ using StumpFinder = std::function<FittedStump(std::span<const float> weights, st
 // the weight, uniform within it): one per sample, a soft cascade's cumulative score F of the stages
 // before (cascade.h). Then boosting goes on from F (Xiao et al.'s boosting chain): sample i starts
 // with weight proportional to exp(-y_i F_i), each class still holding half the total weight (so
-// that the ~2:1 negatives do not outweigh the positives), and the stage threshold is placed on
-// F + the stage's stumps, added in the detector's order (F first, then stump by stump).
+// that the ~2:1 negatives do not outweigh the positives; StageConfig::marginStartWeights = false:
+// uniform within each class instead), and the stage threshold is placed on F + the stage's stumps,
+// added in the detector's order (F first, then stump by stump).
 StageResult boostStage(std::size_t samples, std::size_t positives, const StumpFinder& find,
                        const StageConfig& config,
                        const std::function<void(const RoundInfo&)>& onRound = {},
