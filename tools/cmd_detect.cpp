@@ -14,6 +14,7 @@
 #include "command.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
+#include "fusedet/boost/laser_extent.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/core/dataset.h"
@@ -35,6 +36,7 @@ struct DetectOptions {
   fs::path draw;
   std::optional<double> scaleFactor;
   std::optional<int> minNeighbors;
+  bool laserExtent = false;
   std::string minSize, maxSize;
   std::string group = "opencv";
   double iou = 0.5;
@@ -137,7 +139,10 @@ int runDetect(const DetectOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   ScanStats stats;
   const std::vector<RawHit> hits = detector.scan(stack, scan, &stats);
-  const std::vector<Detection> dets = groupHits(hits, group, c.className, stack);
+  std::vector<Detection> dets = groupHits(hits, group, c.className, stack);
+  LaserExtentParams extent;
+  extent.enabled = o.laserExtent;
+  refineToLaserExtent(dets, stack, extent);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   std::printf("%s on %s (%dx%d): %zu windows at %zu scales, %zu raw hits, %zu detections, %.1f ms\n",
@@ -194,6 +199,8 @@ const bool registered = registerCommand(
       app.add_option("--min-neighbors", o->minNeighbors,
                      "OpenCV grouping: a detection needs more than this many raw hits; 0 = report raw hits "
                      "ungrouped (default 3, as OpenCV)");
+      app.add_flag("--laser-extent", o->laserExtent,
+                   "after grouping, widen each detection's left and right edges to where its object's cluster in the " "distance layer ends (boost/laser_extent.h; default: off)" " - needs a --stack with a distance layer");
       app.add_option("--min-size", o->minSize,
                      "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
                      "smallest training positive, in models that have one - else its base window)");

@@ -33,6 +33,7 @@ struct EvalOptions {
   std::string van = "ignore";
   double scaleFactor = 1.1, step = 2;
   int minNeighbors = 3;
+  bool laserExtent = false;
   int threads = 1;
 };
 
@@ -87,6 +88,7 @@ int runEval(const EvalOptions& o) {
   setup.scan.step = o.step;
   setup.scan.threads = o.threads;
   setup.group.minNeighbors = o.minNeighbors;
+  setup.laserExtent.enabled = o.laserExtent;
   std::vector<const boosting::Detector*> chain;
   for (const auto& d : detectors) chain.push_back(&d);
   const boosting::EvalOutcome r = boosting::evaluateChain(chain, items, match, setup);
@@ -190,6 +192,8 @@ const bool registered = registerCommand(
       app.add_option("--scale-factor", o->scaleFactor, "window scale step")->capture_default_str();
       app.add_option("--step", o->step, "position step in base-window pixels")->capture_default_str();
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
+      app.add_flag("--laser-extent", o->laserExtent,
+                   "after grouping, widen each detection's left and right edges to where its object's cluster in the " "distance layer ends (boost/laser_extent.h; default: off)");
       app.add_option("--threads", o->threads, "detection threads (ms per stack is measured with these)")
           ->capture_default_str();
       app.footer(

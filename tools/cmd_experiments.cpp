@@ -79,6 +79,7 @@ struct ExperimentOptions {
   std::string grouping = "opencv";  // opencv | nms (boosting::GroupParams)
   double nmsIou = 0.5;
   int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
+  bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -570,6 +571,7 @@ int runExperiments(ExperimentOptions o) {
   setup.scan.step = preset.step;
   setup.scan.threads = 1;  // ms per stack on one core, comparable across configurations
   setup.group = groupParams(o);
+  setup.laserExtent.enabled = o.laserExtent;
 
   report.settings = {
       {"preset", preset.name},
@@ -601,6 +603,8 @@ int runExperiments(ExperimentOptions o) {
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
       {"training scan scale factor / step", shortNum(preset.trainScaleFactor) + " / " + shortNum(preset.trainStep)},
       {"grouping", groupingText(o)},
+      {"laser-extent box refinement (--laser-extent)",
+       o.laserExtent ? "on: left/right edges widened to the distance layer's object cluster" : "off"},
       {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
@@ -1098,6 +1102,9 @@ const bool registered = registerCommand(
                      "--grouping opencv with --small-height: hits a group lower than that height needs (more than)")
           ->check(CLI::Range(0, 1000))
           ->capture_default_str();
+      app.add_flag("--laser-extent", o->laserExtent,
+                   "after grouping, widen each test-frame detection's left and right edges to where its object's "
+                   "cluster in the distance layer ends (boost/laser_extent.h; default: off)");
       app.add_option("--contrast-normalise", o->contrastNormalise,
                      "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
                      "window's standard deviation of their layer): none, camera (red, green, blue, intensity "

@@ -22,7 +22,9 @@ std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, co
       if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
     hits = std::move(kept);
   }
-  return groupHits(hits, setup.group, first.cascade().className, stack);
+  std::vector<Detection> dets = groupHits(hits, setup.group, first.cascade().className, stack);
+  refineToLaserExtent(dets, stack, setup.laserExtent);
+  return dets;
 }
 
 EvalOutcome evaluateChain(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,

@@ -187,6 +187,7 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.readOneOf<std::string>("grouping", c.detection.grouping, {"nms", "opencv"});
     s.readRange("nms_iou", c.detection.nmsIou, 0.0, 1.0);
     s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
+    s.read("laser_extent", c.detection.laserExtent);
     s.readRange("threads", c.detection.threads, 0, 256);
     s.finish();
   }
@@ -294,6 +295,7 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "grouping" << YAML::Value << c.detection.grouping;
   out << YAML::Key << "nms_iou" << YAML::Value << c.detection.nmsIou;
   out << YAML::Key << "min_neighbors" << YAML::Value << c.detection.minNeighbors;
+  out << YAML::Key << "laser_extent" << YAML::Value << c.detection.laserExtent;
   out << YAML::Key << "threads" << YAML::Value << c.detection.threads << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << c.replay.file;

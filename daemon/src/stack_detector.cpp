@@ -27,8 +27,14 @@ boosting::GroupParams groupParamsFrom(const Config::Detection& d) {
   return g;
 }
 
+boosting::LaserExtentParams laserExtentFrom(const Config::Detection& d) {
+  boosting::LaserExtentParams p;
+  p.enabled = d.laserExtent;
+  return p;
+}
+
 CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem::path& base)
-    : scan_(scanParamsFrom(settings)), group_(groupParamsFrom(settings)) {
+    : scan_(scanParamsFrom(settings)), group_(groupParamsFrom(settings)), extent_(laserExtentFrom(settings)) {
   if (settings.models.empty()) throw std::runtime_error("detection.models: no model files configured");
   std::set<std::string> seen;
   std::vector<boosting::Cascade> cascades;
@@ -49,7 +55,9 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
 }
 
 std::vector<Detection> CascadeSet::detect(const LayerStack& stack) const {
-  return boosting::detect(*detector_, stack, scan_, group_);
+  std::vector<Detection> found = boosting::detect(*detector_, stack, scan_, group_);
+  refineToLaserExtent(found, stack, extent_);
+  return found;
 }
 
 std::vector<std::string> CascadeSet::classes() const {

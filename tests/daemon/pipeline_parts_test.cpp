@@ -131,6 +131,7 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   EXPECT_EQ(g.method, glib.method);
   EXPECT_EQ(g.minNeighbors, glib.minNeighbors);
   EXPECT_EQ(g.iouThreshold, glib.iouThreshold);
+  EXPECT_EQ(laserExtentFrom(d).enabled, boosting::LaserExtentParams{}.enabled);
 }
 
 // Non-default values written in fusedet.yaml reach the library unchanged, in its units: step in
@@ -138,7 +139,7 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
 TEST(DetectionSettings, YamlKeysMeanWhatTheLibraryMeans) {
   const Config c = parseConfig(
       "detection:\n  step: 3\n  scale_factor: 1.25\n  min_size: [30, 60]\n  max_size: [300, 400]\n"
-      "  grouping: nms\n  nms_iou: 0.3\n  min_neighbors: 5\n  threads: 1\n",
+      "  grouping: nms\n  nms_iou: 0.3\n  min_neighbors: 5\n  laser_extent: true\n  threads: 1\n",
       "test.yaml");
   const boosting::ScanParams s = scanParamsFrom(c.detection);
   EXPECT_EQ(s.step, 3.0);
@@ -152,6 +153,7 @@ TEST(DetectionSettings, YamlKeysMeanWhatTheLibraryMeans) {
   EXPECT_EQ(g.method, boosting::GroupParams::Method::kNms);
   EXPECT_EQ(g.iouThreshold, 0.3);
   EXPECT_EQ(g.minNeighbors, 5);
+  EXPECT_TRUE(laserExtentFrom(c.detection).enabled);
   EXPECT_EQ(groupParamsFrom(parseConfig("detection:\n  grouping: opencv\n", "t.yaml").detection).method,
             boosting::GroupParams::Method::kOpenCv);
 }

@@ -10,6 +10,7 @@
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/grouping.h"
+#include "fusedet/boost/laser_extent.h"
 #include "fusedet/boost/precision_recall.h"
 #include "fusedet/core/dataset.h"
 
@@ -18,6 +19,7 @@ namespace fusedet::boosting {
 struct DetectionSetup {
   ScanParams scan;
   GroupParams group;
+  LaserExtentParams laserExtent;  // box refinement after grouping (off by default)
 };
 
 struct EvalOutcome {

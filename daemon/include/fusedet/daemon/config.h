@@ -84,6 +84,7 @@ struct Config {
     std::string grouping = "opencv";
     double nmsIou = 0.5;
     int minNeighbors = 3;
+    bool laserExtent = false;  // boosting::LaserExtentParams::enabled
     int threads = 0;
   } detection;
 

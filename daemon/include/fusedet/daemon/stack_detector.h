@@ -10,6 +10,7 @@
 
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/grouping.h"
+#include "fusedet/boost/laser_extent.h"
 #include "fusedet/core/detection.h"
 #include "fusedet/core/layer_stack.h"
 #include "fusedet/daemon/config.h"
@@ -28,6 +29,7 @@ class StackDetector {
 // The config's detection section in the library's terms (one meaning for every key).
 boosting::ScanParams scanParamsFrom(const Config::Detection& d);
 boosting::GroupParams groupParamsFrom(const Config::Detection& d);
+boosting::LaserExtentParams laserExtentFrom(const Config::Detection& d);
 
 class CascadeSet : public StackDetector {
  public:
@@ -44,6 +46,7 @@ class CascadeSet : public StackDetector {
   std::vector<std::filesystem::path> files_;
   boosting::ScanParams scan_;
   boosting::GroupParams group_;
+  boosting::LaserExtentParams extent_;  // detection.laser_extent
 };
 
 }  // namespace fusedet::daemon
