@@ -8,6 +8,7 @@
 
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/integral_stack.h"
+#include "fusedet/boost/laser_extent.h"
 #include "window_scanner.h"
 
 namespace fusedet::boosting {
@@ -100,6 +101,7 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
   const std::vector<RawHit> hits = detector.scan(stack, setup.scan);
   std::vector<HitFate> fates;
   out.detections = groupHits(hits, setup.group, cascade.className, stack, &fates);
+  refineToLaserExtent(out.detections, stack, setup.laserExtent);  // as detectChain(): boxes only, same order
   out.match = matchDetections(out.detections, labels, match);
 
   std::map<std::tuple<double, double, double, double>, std::size_t> hitAt;  // window -> raw hit
