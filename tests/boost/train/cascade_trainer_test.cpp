@@ -26,6 +26,7 @@ using namespace fusedet::boosting;
 using fusedet::synthetic::scene;
 using fusedet::synthetic::scenes;
 using fusedet::synthetic::smallConfig;
+using fusedet::synthetic::twoLayerConfig;
 
 namespace {
 
@@ -106,10 +107,7 @@ TEST(CascadeTrainer, LearnsSyntheticCarsAndReportsItsStop) {
 
 TEST(CascadeTrainer, SameSeedSameDataGivesByteIdenticalModelForAnyThreadCount) {
   const auto items = scenes(8, true);
-  TrainingConfig c = smallConfig();
-  c.pool.layers = {"intensity", "hue_distance"};
-  c.maxStages = 2;
-  c.threads = 1;
+  TrainingConfig c = twoLayerConfig();
   NullProgress quiet;
   const std::string one = modelToText(trainCascade(c, items, quiet), {{"seed", "5"}});
   c.threads = 2;
@@ -487,10 +485,7 @@ TEST(CascadeTrainer, ContrastNormalisedTrainingIsRecordedAndSurvivesAGainChange)
 // cost without it), not the time of loading.
 TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
   const auto items = scenes(8, true);
-  TrainingConfig c = smallConfig();
-  c.pool.layers = {"intensity", "hue_distance"};
-  c.maxStages = 2;
-  c.threads = 1;
+  TrainingConfig c = twoLayerConfig();
   const std::vector<std::size_t> train = {0, 1, 2, 3, 4, 5, 6, 7};
   const auto dir = std::filesystem::temp_directory_path() / ("fusedet_fold_cache_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

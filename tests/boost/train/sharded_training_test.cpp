@@ -115,12 +115,9 @@ std::vector<T> onRanks(int ranks, const std::vector<DatasetItem>& items,
 
 // Two layers, 2 stages of several rounds each (not one lucky stump), one thread per rank.
 TrainingConfig shardedConfig() {
-  TrainingConfig c = synthetic::smallConfig();
-  c.pool.layers = {"intensity", "hue_distance"};
-  c.maxStages = 2;
+  TrainingConfig c = synthetic::twoLayerConfig();
   c.stage.maxWeak = 15;
   c.stage.maxFalseAlarm = 0.01;
-  c.threads = 1;
   return c;
 }
 

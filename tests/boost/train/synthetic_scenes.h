@@ -87,4 +87,14 @@ inline boosting::TrainingConfig smallConfig() {
   return c;
 }
 
+// smallConfig() on both layers the hue scenes have, 2 stages, one thread: the quick training
+// of the determinism, cache and sharding tests.
+inline boosting::TrainingConfig twoLayerConfig() {
+  boosting::TrainingConfig c = smallConfig();
+  c.pool.layers = {"intensity", "hue_distance"};
+  c.maxStages = 2;
+  c.threads = 1;
+  return c;
+}
+
 }  // namespace fusedet::synthetic
