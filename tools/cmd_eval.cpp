@@ -78,8 +78,7 @@ int runEval(const EvalOptions& o) {
   std::vector<DatasetItem> items;
   for (const DatasetEntry& e : entries) items.push_back(readDatasetItem(o.data, e.id, layers));
 
-  boosting::MatchConfig match = boosting::matchConfigFor(cls, boosting::parseVanPolicy(o.van));
-  if (o.minIou > 0) match.minIou = o.minIou;
+  boosting::MatchConfig match = boosting::matchConfigFor(cls, boosting::parseVanPolicy(o.van), o.minIou);
   match.minHeight = o.minHeight;
   match.maxOcclusion = o.maxOcclusion;
   match.maxTruncation = o.maxTruncation;

@@ -490,11 +490,7 @@ int runExperiments(ExperimentOptions o) {
   if (o.out.empty()) throw std::runtime_error("--out is required");
   fs::create_directories(o.out);
   const boosting::VanPolicy van = boosting::parseVanPolicy(o.van);
-  const auto matchFor = [&](const std::string& cls) {
-    boosting::MatchConfig m = boosting::matchConfigFor(cls, van);
-    if (o.minIou > 0) m.minIou = o.minIou;
-    return m;
-  };
+  const auto matchFor = [&](const std::string& cls) { return boosting::matchConfigFor(cls, van, o.minIou); };
   o.classStages = parseClassStages(o.classStagesText);
   for (const auto& [cls, n] : o.classStages)
     if (std::find(o.classes.begin(), o.classes.end(), cls) == o.classes.end())

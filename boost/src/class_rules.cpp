@@ -22,10 +22,10 @@ std::string toString(VanPolicy policy) {
 
 double kittiMinOverlap(const std::string& className) { return className == "car" ? 0.7 : 0.5; }
 
-MatchConfig matchConfigFor(const std::string& className, VanPolicy van) {
+MatchConfig matchConfigFor(const std::string& className, VanPolicy van, double minIou) {
   MatchConfig c;
   c.className = className;
-  c.minIou = kittiMinOverlap(className);
+  c.minIou = minIou > 0 ? minIou : kittiMinOverlap(className);
   if (className == "car" && van == VanPolicy::kIgnore) c.neighbourClasses = {"van", "Van"};
   if (className == "car" && van == VanPolicy::kPositive) c.aliasClasses = {"van"};
   if (className == "person") c.neighbourClasses = {"Person_sitting"};

@@ -71,6 +71,8 @@ TEST(KittiRules, MinimumOverlapIsPointSevenForCarAndPointFiveForPersonAndBike) {
   EXPECT_EQ(kittiMinOverlap("car"), 0.7);
   EXPECT_EQ(kittiMinOverlap("person"), 0.5);
   EXPECT_EQ(kittiMinOverlap("bike"), 0.5);
+  EXPECT_EQ(matchConfigFor("car").minIou, 0.7);
+  EXPECT_EQ(matchConfigFor("car", VanPolicy::kIgnore, 0.5).minIou, 0.5);  // --min-iou 0.5 (PASCAL)
   for (const std::string cls : {"car", "person", "bike"}) {
     const Labels labels{label(cls, cls, {100, 50, 100, 50})};
     const StackMatch at06 = matchDetections({det({125, 50, 100, 50})}, labels, matchConfigFor(cls));

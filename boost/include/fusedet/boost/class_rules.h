@@ -23,7 +23,8 @@ double kittiMinOverlap(const std::string& className);
 // KITTI moderate for one class: height >= 25 px, occlusion <= 1, truncation <= 0.3, IoU >=
 // kittiMinOverlap(class) (car 0.7, person and bike 0.5), detections < 25 px ignored; neighbour classes Van (car, per policy) and Person_sitting (person);
 // DontCare absorbs; Truck, Tram, Misc are false alarms.
-MatchConfig matchConfigFor(const std::string& className, VanPolicy van = VanPolicy::kIgnore);
+// minIou > 0 replaces the devkit's overlap for this class (e.g. 0.5 = PASCAL, the tools' --min-iou).
+MatchConfig matchConfigFor(const std::string& className, VanPolicy van = VanPolicy::kIgnore, double minIou = 0);
 
 // Labels as the trainer should see them for one class: positives are the labels that are
 // positives in evaluation (aliases renamed to the class); ignored labels (below moderate or of
