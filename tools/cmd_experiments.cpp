@@ -33,6 +33,8 @@
 #include "fusedet/boost/experiment_plan.h"
 #include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/model_io.h"
+#include "fusedet/boost/outcomes_file.h"
+#include "fusedet/boost/paired_comparison.h"
 #include "fusedet/fusion/kitti_drives.h"
 #include "fusedet/fusion/kitti_import.h"
 #include "fusedet/fusion/kitti_tracks.h"
@@ -435,37 +437,21 @@ Measured measure(const std::vector<boosting::FrameOutcome>& frames, const boosti
   return m;
 }
 
-// Paired difference a - b of F and AP on the same resampled frames.
+// Paired difference a - b of F and AP on the same resampled frames (boost/paired_comparison.h).
 Claim compare(const std::string& cls, const std::string& key, const std::string& text, const std::string& lhs,
               const std::vector<boosting::FrameOutcome>& a, const std::string& rhs,
               const std::vector<boosting::FrameOutcome>& b, const boosting::BootstrapConfig& boot) {
-  std::vector<std::size_t> all(a.size());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-  const auto diff = [&](auto fn) {
-    return [&, fn](const std::vector<std::size_t>& idx) -> std::optional<double> {
-      const auto x = fn(a, idx), y = fn(b, idx);
-      if (!x || !y) return std::nullopt;
-      return *x - *y;
-    };
-  };
-  const auto fOf = [](const std::vector<boosting::FrameOutcome>& fr, const std::vector<std::size_t>& idx) {
-    return boosting::fMeasureOf(fr, idx);
-  };
-  const auto apOf = [](const std::vector<boosting::FrameOutcome>& fr, const std::vector<std::size_t>& idx) {
-    return boosting::averagePrecisionOf(fr, idx);
-  };
+  const boosting::PairedComparison p = boosting::comparePaired(a, b, boot);
   Claim c;
   c.className = cls;
   c.key = key;
   c.text = text;
   c.lhs = lhs;
   c.rhs = rhs;
-  c.fDifference.value = diff(fOf)(all);
-  c.fDifference.interval = boosting::bootstrapInterval(a.size(), diff(fOf), boot);
-  c.apDifference.value = diff(apOf)(all);
-  c.apDifference.interval = boosting::bootstrapInterval(a.size(), diff(apOf), boot);
-  c.verdict = boosting::verdict(c.fDifference.interval);
-  c.apVerdict = boosting::verdict(c.apDifference.interval);
+  c.fDifference = {p.f.difference, p.f.interval};
+  c.apDifference = {p.ap.difference, p.ap.interval};
+  c.verdict = p.f.verdict;
+  c.apVerdict = p.ap.verdict;
   return c;
 }
 
@@ -725,6 +711,23 @@ int runExperiments(ExperimentOptions o) {
     report.totalSeconds = std::chrono::duration<double>(Clock::now() - tStart).count();
     report.loadAverage = loadAverage();
     writeReport(o.out, report);
+    // Per-frame outcomes of every row, for paired comparisons with other runs (`fusedet compare`).
+    boosting::RunOutcomes outcomes;
+    outcomes.command = o.commandLine;
+    for (const ConfigResult& r : report.results) {
+      const auto c = framesOf.find(r.className);
+      if (c == framesOf.end() || !c->second.count(r.config)) continue;
+      boosting::OutcomeSet set;
+      set.className = r.className;
+      set.protocol = boosting::protocolName(folds.size(), driveCount);
+      set.folds = folds.size();
+      set.config = r.config;
+      set.rule = matchFor(r.className);
+      for (const DatasetEntry& e : manifest) set.frameIds.push_back(e.id);
+      set.frames = c->second.at(r.config);
+      outcomes.sets.push_back(std::move(set));
+    }
+    boosting::writeOutcomes(o.out / "outcomes.json", outcomes);
   };
 
   const auto runConfig = [&](const std::string& cls, const std::string& config) {

@@ -1,0 +1,62 @@
+#pragma once
+// Paired comparison of two detectors on the same frames: F and AP of each, and the 95 % bootstrap
+// interval of the difference a - b with the frames resampled once for both (bootstrap.h), so a
+// frame that is hard for both counts in both. Verdict on "a is better than b": "holds" (interval
+// above 0), "contradicted" (below 0), "not shown" (contains 0: a tie).
+//
+// Used for the paper's claims inside one `fusedet experiments` run and, on two runs' outcomes.json
+// files (outcomes_file.h), for an option against the default (`fusedet compare`). Two saved sets
+// are only compared when they are the same experiment on the same frames: same class, same
+// matching rule (IoU, moderate limits, neighbour classes...) and the same set of frame names;
+// anything else is refused with a ComparisonError that says what differs.
+
+#include <cstddef>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fusedet/boost/bootstrap.h"
+#include "fusedet/boost/outcomes_file.h"
+#include "fusedet/boost/precision_recall.h"
+
+namespace fusedet::boosting {
+
+struct PairedMeasure {
+  std::optional<double> a, b, difference;  // on all frames; nullopt where undefined
+  std::optional<Interval> interval;        // of a - b over paired resamples
+  std::string verdict;                     // verdict(interval)
+};
+
+struct PairedComparison {
+  std::size_t frames = 0;
+  Counts countsA, countsB;
+  PairedMeasure f, ap;  // F at the operating point; AP (KITTI, 40 recall points)
+};
+
+// a and b: outcomes of the same frames in the same order (std::invalid_argument otherwise).
+PairedComparison comparePaired(const std::vector<FrameOutcome>& a, const std::vector<FrameOutcome>& b,
+                               const BootstrapConfig& boot = {});
+
+struct ComparisonError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Two saved sets (frames matched by name, in a's order). Refuses different classes, rules or
+// frame sets.
+PairedComparison compareSets(const OutcomeSet& a, const OutcomeSet& b, const BootstrapConfig& boot = {});
+
+// Which sets to compare; empty = any.
+struct ComparisonFilter {
+  std::string className, protocol, config;
+};
+struct ComparisonRow {
+  std::string className, protocol, config;
+  PairedComparison result;
+};
+// Every (class, protocol, configuration) present in both runs and passing the filter, in a's
+// order. Refuses (ComparisonError) when no set pairs up, listing what each run has.
+std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& b, const ComparisonFilter& filter,
+                                       const BootstrapConfig& boot = {});
+
+}  // namespace fusedet::boosting
