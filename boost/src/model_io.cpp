@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "text_position.h"
+
 namespace fusedet::boosting {
 
 namespace {
@@ -65,19 +67,6 @@ class Reader {
  private:
   std::string source_;
 };
-
-std::string lineColumn(const std::string& text, std::size_t byte) {
-  std::size_t line = 1, col = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(col);
-}
 
 }  // namespace
 

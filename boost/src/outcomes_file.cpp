@@ -6,6 +6,8 @@
 #include <set>
 #include <sstream>
 
+#include "text_position.h"
+
 namespace fusedet::boosting {
 namespace {
 
@@ -127,19 +129,6 @@ void frameFromJson(const Reader& r, const Json& j, const std::string& where, Out
                       " positives (each positive is hit at most once)");
   set.frameIds.push_back(id);
   set.frames.push_back(std::move(f));
-}
-
-std::string lineColumn(const std::string& text, std::size_t byte) {
-  std::size_t line = 1, col = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      col = 1;
-    } else {
-      ++col;
-    }
-  }
-  return "line " + std::to_string(line) + ", column " + std::to_string(col);
 }
 
 }  // namespace
