@@ -4,7 +4,8 @@
 // 1.5) and its groups average windows, so a car box is often too narrow at the KITTI devkit's
 // IoU 0.7; the laser sees the object's extent. Off by default: car F at IoU 0.7 rises from 0.43
 // to 0.49 on 3 drive-disjoint folds but only from 0.51 to 0.53 leave-one-drive-out (+4 hits of
-// 186, inside the intervals: a tie; boost/README.md).
+// 186; paired interval of the difference +0.02 [-0.005, 0.05]: a tie across drives; `fusedet
+// compare`, boost/README.md).
 //
 // Rule, in the distance layer's cells (the box mapped through unit coordinates):
 //  - band: the box's rows from 35 % to 85 % of its height (a car's body below the windows, which
