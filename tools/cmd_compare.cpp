@@ -2,6 +2,7 @@
 // same frames with paired bootstrap intervals of F and AP. The rules are in
 // boost/paired_comparison.h and boost/outcomes_file.h; this parses and prints.
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -45,6 +46,11 @@ nlohmann::json countsJson(const boosting::Counts& c) {
   return {{"hits", c.hits}, {"false_alarms", c.falseAlarms}, {"misses", c.misses}, {"positives", c.positives}};
 }
 
+// "all", or "all:drives=8/all:drives=4" when B's configuration is another.
+std::string configLabel(const boosting::ComparisonRow& r) {
+  return r.config == r.configB ? r.config : r.config + "/" + r.configB;
+}
+
 int runCompare(const CompareOptions& o) {
   const boosting::RunOutcomes a = boosting::readOutcomes(o.a), b = boosting::readOutcomes(o.b);
   boosting::BootstrapConfig boot;
@@ -62,6 +68,7 @@ int runCompare(const CompareOptions& o) {
       j["rows"].push_back({{"class", r.className},
                            {"protocol", r.protocol},
                            {"config", r.config},
+                           {"config_b", r.configB},
                            {"frames", r.result.frames},
                            {"counts_a", countsJson(r.result.countsA)},
                            {"counts_b", countsJson(r.result.countsB)},
@@ -73,13 +80,15 @@ int runCompare(const CompareOptions& o) {
 
   std::printf("compare: A %s: %s\n", o.a.c_str(), a.command.c_str());
   std::printf("compare: B %s: %s\n", o.b.c_str(), b.command.c_str());
-  std::printf("%-7s %-8s %-11s %6s %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %s\n", "class", "protocol", "config",
+  int width = 11;  // the config column fits the longest label (learning-curve pairs are long)
+  for (const auto& r : rows) width = std::max(width, static_cast<int>(configLabel(r).size()));
+  std::printf("%-7s %-8s %-*s %6s %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %s\n", "class", "protocol", width, "config",
               "frames", "F_a", "F_b", "F_a-F_b", "[95 % CI]", "verdict", "AP_a", "AP_b", "AP_a-b", "[95 % CI]",
               "verdict", "hits/FA/misses a; b");
   for (const auto& r : rows) {
     const auto& c = r.result;
-    std::printf("%-7s %-8s %-11s %6zu %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %zu/%zu/%zu; %zu/%zu/%zu\n",
-                r.className.c_str(), r.protocol.c_str(), r.config.c_str(), c.frames, fixed(c.f.a).c_str(),
+    std::printf("%-7s %-8s %-*s %6zu %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %zu/%zu/%zu; %zu/%zu/%zu\n",
+                r.className.c_str(), r.protocol.c_str(), width, configLabel(r).c_str(), c.frames, fixed(c.f.a).c_str(),
                 fixed(c.f.b).c_str(), fixed(c.f.difference, true).c_str(), interval(c.f.interval).c_str(),
                 c.f.verdict.c_str(), fixed(c.ap.a).c_str(), fixed(c.ap.b).c_str(),
                 fixed(c.ap.difference, true).c_str(), interval(c.ap.interval).c_str(), c.ap.verdict.c_str(),
@@ -90,7 +99,7 @@ int runCompare(const CompareOptions& o) {
               o.resamples, static_cast<unsigned long long>(o.seed));
   for (const auto& r : rows)
     std::printf("compare: %s %s %s: F %s %s %s; AP %s %s %s\n", r.className.c_str(), r.protocol.c_str(),
-                r.config.c_str(), fixed(r.result.f.difference, true).c_str(), interval(r.result.f.interval).c_str(),
+                configLabel(r).c_str(), fixed(r.result.f.difference, true).c_str(), interval(r.result.f.interval).c_str(),
                 r.result.f.verdict.c_str(), fixed(r.result.ap.difference, true).c_str(),
                 interval(r.result.ap.interval).c_str(), r.result.ap.verdict.c_str());
   return 0;
@@ -111,19 +120,24 @@ const bool registered = registerCommand(
                      "only this protocol: lodo (leave-one-drive-out, --folds 0) or <k>fold (e.g. 3fold, --folds 3); "
                      "default: every protocol");
       app.add_option("--config", o->filter.config,
-                     "only this configuration (all = the joint pool, no_corners, laser, camera, four, and, channels, "
-                     "hog); default: every configuration");
+                     "only this configuration: all (the joint pool), no_corners, laser, camera, four, and, channels, "
+                     "hog; a stage-sweep point all:stages=N,nb=M (--stage-sweep); a learning-curve point "
+                     "all:drives=K or all:positives=N|all; default: every configuration");
+      app.add_option("--config-b", o->filter.configB,
+                     "with --config: B's configuration to pair with A's, when it has another name - e.g. two "
+                     "configurations or learning-curve points of one run: `fusedet compare RUN RUN --config "
+                     "all:drives=8 --config-b all:drives=4`; the table's config column then reads A_CONFIG/B_CONFIG");
       app.add_option("--bootstrap", o->resamples, "bootstrap resamples of the frames")
           ->check(CLI::Range(1, 1000000))
           ->capture_default_str();
       app.add_option("--seed", o->seed, "bootstrap seed (same seed + files = same intervals)")->capture_default_str();
       app.add_flag("--json", o->json,
                    "print one JSON object instead of the table: a, b (path, command), bootstrap, rows [{class, "
-                   "protocol, config, frames, counts_a, counts_b, f_measure, average_precision}], each measure "
+                   "protocol, config, config_b, frames, counts_a, counts_b, f_measure, average_precision}], each measure "
                    "{a, b, difference, interval {lo, hi, resamples} | null, verdict}");
       app.footer(
           "Every `fusedet experiments` run writes OUT/outcomes.json beside results.json: per class, protocol and "
-          "configuration, each test frame's name, positives and counted detections (score, hit or false "
+          "configuration (also each stage-sweep and learning-curve point), each test frame's name, positives and counted detections (score, hit or false "
           "alarm) - what F and AP are computed from (format: docs/results/README.md, \"outcomes.json\"). "
           "compare pairs the (class, protocol, configuration) sets present in both runs and, for each, "
           "resamples the frames with replacement once for both runs (paired bootstrap): the 95 % percentile "
@@ -144,7 +158,8 @@ const bool registered = registerCommand(
           "  fusedet experiments --classes car --configs all --folds 0 --learning none --no-peers \\\n"
           "      --laser-extent --out ext\n"
           "  fusedet compare ext def                       # laser extent minus default\n"
-          "  fusedet compare ext def --class car --protocol lodo --config all --json | jq '.rows[0].f_measure'");
+          "  fusedet compare ext def --class car --protocol lodo --config all --json | jq '.rows[0].f_measure'\n"
+          "  fusedet compare run run --class car --config all:drives=8 --config-b all:drives=4   # more data helps?");
       return [o] { return runCompare(*o); };
     });
 

@@ -659,6 +659,14 @@ int runExperiments(ExperimentOptions o) {
   // Claims, goals and charts from what is measured so far; the report is rewritten after every
   // step, so a run stopped early still leaves a report of what it finished (marked partial).
   std::map<std::string, boosting::FoldModel> foldModels;  // every fold model the run used, as first used
+  // Rows besides the configurations whose test-frame outcomes go to outcomes.json too: stage-sweep
+  // points ("all:stages=6,nb=2") and learning-curve points ("all:drives=4", "all:positives=32").
+  struct ExtraOutcomes {
+    std::string className, config;
+    std::size_t folds = 0;
+    std::vector<boosting::FrameOutcome> frames;
+  };
+  std::vector<ExtraOutcomes> extraOutcomes;
   const auto writeSoFar = [&](bool finished) {
     report.cachedTrainSeconds = 0;
     for (const auto& [key, m] : foldModels) report.cachedTrainSeconds += m.cached ? m.trainSeconds : 0;
@@ -714,19 +722,25 @@ int runExperiments(ExperimentOptions o) {
     // Per-frame outcomes of every row, for paired comparisons with other runs (`fusedet compare`).
     boosting::RunOutcomes outcomes;
     outcomes.command = o.commandLine;
+    const auto addSet = [&](const std::string& cls, const std::string& config, std::size_t foldCount,
+                            const std::vector<boosting::FrameOutcome>& frames) {
+      for (const boosting::OutcomeSet& x : outcomes.sets)  // e.g. two learning counts capped to the same
+        if (x.className == cls && x.folds == foldCount && x.config == config) return;
+      boosting::OutcomeSet set;
+      set.className = cls;
+      set.protocol = boosting::protocolName(foldCount, driveCount);
+      set.folds = foldCount;
+      set.config = config;
+      set.rule = matchFor(cls);
+      for (const DatasetEntry& e : manifest) set.frameIds.push_back(e.id);
+      set.frames = frames;
+      outcomes.sets.push_back(std::move(set));
+    };
     for (const ConfigResult& r : report.results) {
       const auto c = framesOf.find(r.className);
-      if (c == framesOf.end() || !c->second.count(r.config)) continue;
-      boosting::OutcomeSet set;
-      set.className = r.className;
-      set.protocol = boosting::protocolName(folds.size(), driveCount);
-      set.folds = folds.size();
-      set.config = r.config;
-      set.rule = matchFor(r.className);
-      for (const DatasetEntry& e : manifest) set.frameIds.push_back(e.id);
-      set.frames = c->second.at(r.config);
-      outcomes.sets.push_back(std::move(set));
+      if (c != framesOf.end() && c->second.count(r.config)) addSet(r.className, r.config, folds.size(), c->second.at(r.config));
     }
+    for (const ExtraOutcomes& x : extraOutcomes) addSet(x.className, x.config, x.folds, x.frames);
     boosting::writeOutcomes(o.out / "outcomes.json", outcomes);
   };
 
@@ -824,6 +838,8 @@ int runExperiments(ExperimentOptions o) {
                       p.counts.falseAlarms, p.counts.misses);
           std::fflush(stdout);
           report.sweep.push_back(p);
+          extraOutcomes.push_back({cls, "all:stages=" + std::to_string(stages) + ",nb=" + std::to_string(mn), folds.size(),
+                                   cv.frames});
           writeSoFar(false);
         }
     }
@@ -839,8 +855,10 @@ int runExperiments(ExperimentOptions o) {
   // point also scored on its own training frames. A subset already measured (the same training
   // items in every fold, e.g. "all" on both axes) is not run again.
   std::map<std::pair<std::string, std::vector<std::vector<std::size_t>>>, LearningPoint> measuredSubsets;
+  std::map<std::pair<std::string, std::vector<std::vector<std::size_t>>>, std::vector<boosting::FrameOutcome>>
+      measuredFrames;  // their held-out outcomes
   const auto learningPoint = [&](const std::string& cls, LearningPoint p, const std::vector<boosting::Fold>& sub,
-                                 const std::string& what) {
+                                 const std::string& what, const std::string& outcomesName) {
     const boosting::MatchConfig match = matchFor(cls);
     p.perFold.clear();
     for (const boosting::Fold& f : sub) p.perFold.push_back(boosting::countTrainingSet(f, labels, driveOf, objectIds, match));
@@ -884,7 +902,9 @@ int runExperiments(ExperimentOptions o) {
       p.f = mm.f;
       p.ap = mm.ap;
       measuredSubsets[key] = p;
+      measuredFrames[key] = std::move(frames);
     }
+    extraOutcomes.push_back({cls, outcomesName, sub.size(), measuredFrames[key]});
     std::string positives;
     for (const auto& c : p.perFold) positives += (positives.empty() ? "" : "/") + std::to_string(c.positives);
     std::printf("%-7s learning curve: %s  F %s  AP %s; training frames F %s  AP %s (positives per fold %s)\n",
@@ -906,7 +926,7 @@ int runExperiments(ExperimentOptions o) {
         for (const auto& f : learningFolds) sub.push_back(boosting::learningCurveFold(f, driveOf, k, o.seed));
         char what[48];
         std::snprintf(what, sizeof what, "%2zu drives", k);
-        learningPoint(cls, p, sub, what);
+        learningPoint(cls, p, sub, what, "all:drives=" + std::to_string(k));
       }
       const std::vector<std::size_t> positivesOfItem =
           boosting::positivesPerItem(labels, matchFor(cls));
@@ -917,7 +937,8 @@ int runExperiments(ExperimentOptions o) {
         p.requested = n;
         std::vector<boosting::Fold> sub;
         for (const auto& f : learningFolds) sub.push_back(boosting::learningPositivesFold(f, positivesOfItem, n, o.seed));
-        learningPoint(cls, p, sub, n ? ">= " + std::to_string(n) + " positives" : "all positives");
+        learningPoint(cls, p, sub, n ? ">= " + std::to_string(n) + " positives" : "all positives",
+                      "all:positives=" + (n ? std::to_string(n) : std::string("all")));
       }
     }
 

@@ -134,12 +134,16 @@ std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& 
            (filter.protocol.empty() || s.protocol == filter.protocol) &&
            (filter.config.empty() || s.config == filter.config);
   };
+  if (!filter.configB.empty() && filter.config.empty())
+    throw std::invalid_argument("a configuration of the second run (" + filter.configB +
+                                ") needs the first run's configuration to pair it with");
   std::vector<ComparisonRow> rows;
   for (const OutcomeSet& x : a.sets) {
     if (!passes(x)) continue;
+    const std::string other = filter.configB.empty() ? x.config : filter.configB;
     for (const OutcomeSet& y : b.sets)
-      if (y.className == x.className && y.protocol == x.protocol && y.config == x.config)
-        rows.push_back({x.className, x.protocol, x.config, compareSets(x, y, boot)});
+      if (y.className == x.className && y.protocol == x.protocol && y.config == other)
+        rows.push_back({x.className, x.protocol, x.config, other, compareSets(x, y, boot)});
   }
   if (rows.empty()) {
     const auto has = [&](const RunOutcomes& r) {
@@ -151,6 +155,7 @@ std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& 
     if (!filter.className.empty()) f += " class " + filter.className;
     if (!filter.protocol.empty()) f += " protocol " + filter.protocol;
     if (!filter.config.empty()) f += " config " + filter.config;
+    if (!filter.configB.empty()) f += " against config " + filter.configB;
     throw ComparisonError("no class / protocol / configuration" + (f.empty() ? "" : " matching" + f) +
                           " is in both runs (first: " + has(a) + "; second: " + has(b) + ")");
   }

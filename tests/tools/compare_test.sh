@@ -35,6 +35,11 @@ assert "+0.000 [+0.000, +0.000]   not shown" in line, line
 assert "%.3f  %.3f" % (ap, ap) in line, (line, ap)
 print("ok: F %.3f, AP %.3f as results.json" % (f, ap))
 EOF
+  # Learning-curve points are in outcomes.json too and pair within one run (--config-b).
+  "$fusedet" compare "$quick" "$quick" --class car --config all:positives=all --config-b all:positives=16 \
+    >"$work/curve.txt" || fail "compare of two learning-curve points failed"
+  cat "$work/curve.txt"
+  grep -qE '^car +3fold +all:positives=all/all:positives=16 +104 ' "$work/curve.txt" || fail "learning-curve pair row"
   exit 0
 fi
 

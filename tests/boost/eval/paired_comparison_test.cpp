@@ -170,9 +170,16 @@ TEST(PairedComparison, RunsPairTheirSetsAndFilter) {
   ASSERT_EQ(rows.size(), 2u);  // laser is only in a
   EXPECT_EQ(rows[0].className, "car");
   EXPECT_EQ(rows[1].className, "person");
-  EXPECT_EQ(compareRuns(a, b, {"person", "", ""}).size(), 1u);
-  EXPECT_EQ(compareRuns(a, b, {"", "lodo", "all"}).size(), 2u);
-  const std::string none = errorOf([&] { compareRuns(a, b, {"", "3fold", ""}); });
+  EXPECT_EQ(compareRuns(a, b, {"person", "", "", ""}).size(), 1u);
+  EXPECT_EQ(compareRuns(a, b, {"", "lodo", "all", ""}).size(), 2u);
+  // Another configuration of b (e.g. a learning-curve point of the same run): a's laser against b's all.
+  const std::vector<ComparisonRow> cross = compareRuns(a, b, {"car", "", "laser", "all"});
+  ASSERT_EQ(cross.size(), 1u);
+  EXPECT_EQ(cross[0].config, "laser");
+  EXPECT_EQ(cross[0].configB, "all");
+  EXPECT_EQ(rows[0].configB, "all");
+  EXPECT_THROW(compareRuns(a, b, {"car", "", "", "all"}), std::invalid_argument);
+  const std::string none = errorOf([&] { compareRuns(a, b, {"", "3fold", "", ""}); });
   EXPECT_NE(none.find("no class / protocol / configuration matching protocol 3fold is in both runs (first: car / "
                       "lodo / all, car / lodo / laser, person / lodo / all; second: person / lodo / all, car / lodo / "
                       "all)"),

@@ -46,16 +46,18 @@ struct ComparisonError : std::runtime_error {
 // frame sets.
 PairedComparison compareSets(const OutcomeSet& a, const OutcomeSet& b, const BootstrapConfig& boot = {});
 
-// Which sets to compare; empty = any.
+// Which sets to compare; empty = any. configB (needs config): b's configuration paired with a's
+// `config` instead of the same name, e.g. a learning-curve point against another of the same run.
 struct ComparisonFilter {
-  std::string className, protocol, config;
+  std::string className, protocol, config, configB;
 };
 struct ComparisonRow {
-  std::string className, protocol, config;
+  std::string className, protocol, config, configB;  // configB = config unless the filter names another
   PairedComparison result;
 };
-// Every (class, protocol, configuration) present in both runs and passing the filter, in a's
-// order. Refuses (ComparisonError) when no set pairs up, listing what each run has.
+// Every (class, protocol, configuration) present in both runs and passing the filter (b's
+// configuration = filter.configB when given), in a's order. Refuses (ComparisonError) when no set
+// pairs up, listing what each run has, and configB without config (std::invalid_argument).
 std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& b, const ComparisonFilter& filter,
                                        const BootstrapConfig& boot = {});
 
