@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -22,6 +23,11 @@ constexpr std::uint8_t kDeviceAddress = 0x80;
 // Rotations missed while the thread was descheduled are replayed up to this far back; a longer
 // gap is a stopped process, and its scans are counted (scansStalled) rather than burst out.
 constexpr auto kMaxCatchUp = std::chrono::seconds(1);
+// Receive buffer of a real host serial port (Linux TTYB_DEFAULT_MEM_LIMIT): only beyond it are
+// device bytes lost (overrunBytes). A pty holds less, so the simulator keeps the rest (toHost_).
+constexpr std::size_t kHostBuffer = 640 * 1024;
+// The pty slave's line-discipline read buffer (N_TTY): TIOCINQ counts bytes waiting there.
+constexpr int kPtyReadBuffer = 4095;
 
 std::vector<std::uint8_t> ascii(const std::string& s) { return {s.begin(), s.end()}; }
 
@@ -77,6 +83,8 @@ Result<void> Simulator::attachTty() {
 
 void Simulator::destroyPty() {
   if (!options_.link.empty()) ::unlink(options_.link.c_str());
+  toHost_.clear();
+  toHostBytes_ = 0;
   master_.reset();
   slaveHold_.reset();
 }
@@ -427,8 +435,8 @@ void Simulator::readHost(Clock::time_point now) {
         out_.push_back(Output{{kNak}, now, false, false, 0});
         continue;
       }
-      out_.push_back(Output{{kAck}, now, false, false, 0});
-      handleRequest(e->telegram, now);
+      out_.push_back(Output{{kAck}, now + faults_.ackDelay, false, false, 0});
+      handleRequest(e->telegram, now + faults_.ackDelay);
     }
   }
 }
@@ -467,21 +475,15 @@ void Simulator::pumpOutput(Clock::time_point now) {
     }
     if (!bytes.empty()) {
       const int host = hostBaud();
-      std::size_t written = 0;
-      if (host == baud_) {
-        const ssize_t n = ::write(master_.get(), bytes.data(), bytes.size());
-        written = static_cast<std::size_t>(std::max<ssize_t>(n, 0));
-        // The host's receive buffer is full (it stopped reading): an overrun, counted apart
-        // from the bytes a speed mismatch swallows.
-        counters_.overrunBytes += bytes.size() - written;
-      } else {
-        counters_.undeliveredBytes += bytes.size();
-      }
-      counters_.bytesOut += bytes.size();
       if (options_.trace)
         std::fprintf(stderr, "%s sim: sent 0x%02X (%zu bytes) at %d baud, host at %d%s\n", Stamp::now().toString().c_str(),
                      o.bytes.size() > 4 ? o.bytes[4] : o.bytes[0], bytes.size(), baud_, host,
-                     host != baud_ ? " - NOT DELIVERED" : written < bytes.size() ? " - OVERRUN" : "");
+                     host != baud_ ? " - NOT DELIVERED" : toHostBytes_ > 0 ? " - host buffer" : "");
+      counters_.bytesOut += bytes.size();
+      if (host == baud_)
+        toHost(std::move(bytes));
+      else
+        counters_.undeliveredBytes += bytes.size();
     }
     lineFreeAt_ = end;
     if (o.telegram) {
@@ -503,6 +505,47 @@ void Simulator::pumpOutput(Clock::time_point now) {
     }
     if (o.baudAfter) setDeviceBaud(o.baudAfter);
     out_.pop_front();
+  }
+}
+
+// Into the host's receive buffer, behind what is already waiting there; bytes beyond a real
+// port's buffer are an overrun, counted apart from those a speed mismatch swallows.
+void Simulator::toHost(std::vector<std::uint8_t> bytes) {
+  if (toHostBytes_ + bytes.size() > kHostBuffer) {
+    const std::size_t keep = kHostBuffer - std::min(kHostBuffer, toHostBytes_);
+    counters_.overrunBytes += bytes.size() - keep;
+    bytes.resize(keep);
+    if (bytes.empty()) return;
+  }
+  toHostBytes_ += bytes.size();
+  toHost_.push_back(std::move(bytes));
+  flushToHost();
+}
+
+// How many bytes the host's tty can take now without splitting a unit: the pty slave's read
+// buffer has room for 4095 minus what waits in it (unknown on an attached tty: no limit here).
+std::size_t Simulator::hostReadRoom() const {
+  if (!slaveHold_.valid()) return kHostBuffer;
+  int queued = 0;
+  if (::ioctl(slaveHold_.get(), TIOCINQ, &queued) != 0) return kHostBuffer;
+  return queued >= kPtyReadBuffer ? 0 : static_cast<std::size_t>(kPtyReadBuffer - queued);
+}
+
+// Waiting units enter the pty in order and whole while the host's read buffer has room for them
+// (a unit the pty still cuts short keeps its rest at the front).
+void Simulator::flushToHost() {
+  while (!toHost_.empty() && master_.valid()) {
+    std::vector<std::uint8_t>& unit = toHost_.front();
+    if (unit.size() > hostReadRoom()) return;
+    const ssize_t n = ::write(master_.get(), unit.data(), unit.size());
+    if (n <= 0) return;
+    const auto written = static_cast<std::size_t>(n);
+    toHostBytes_ -= written;
+    if (written < unit.size()) {
+      unit.erase(unit.begin(), unit.begin() + n);
+      return;
+    }
+    toHost_.pop_front();
   }
 }
 
@@ -529,6 +572,7 @@ void Simulator::run() {
       continue;
     }
     readHost(now);
+    flushToHost();  // what waited for the host to read, before anything newer
     const bool streaming = mode_ == 0x24 || mode_ == 0x2A || mode_ == 0x2B;
     if (streaming && now < silentUntil_) nextRotation_ = now + kRotation;  // a hung device measures nothing
     if (streaming && now >= nextRotation_) {

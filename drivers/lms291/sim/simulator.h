@@ -45,6 +45,9 @@ struct Faults {
   double dropRate = 0;     // per output byte: byte not sent
   double garbageRate = 0;  // per telegram: a burst of 1..16 random bytes before it
   double nakRate = 0;      // per valid request: answered with NAK instead
+  // Request -> ACK (a late device; longer than the host's ACK timeout makes it send the request
+  // again, and every copy is answered).
+  std::chrono::milliseconds ackDelay{0};
   bool operator==(const Faults&) const = default;
 };
 
@@ -93,7 +96,9 @@ struct SimCounters {
   std::uint64_t naksInjected = 0;
   std::uint64_t ignoredBytes = 0;      // host bytes at the wrong speed
   std::uint64_t undeliveredBytes = 0;  // device bytes while the host speed differed
-  std::uint64_t overrunBytes = 0;      // device bytes the host's full receive buffer refused
+  // Device bytes refused because the host's receive buffer was full: it stopped reading for longer
+  // than a real serial port's kernel buffer (640 KB) lasts; a pty's smaller buffer does not count.
+  std::uint64_t overrunBytes = 0;
   std::uint64_t vanishes = 0;
   std::uint64_t powerOns = 0;
 };
@@ -158,6 +163,9 @@ class Simulator {
   std::uint16_t encodeRange(double meters) const;
   bool logRefuses(std::optional<Variant> v, std::optional<Unit> unit) const;
   void pumpOutput(Clock::time_point now);
+  void toHost(std::vector<std::uint8_t> bytes);
+  void flushToHost();
+  std::size_t hostReadRoom() const;
   Clock::duration lineTime(std::size_t bytes) const;
   int hostBaud() const;
   void setDeviceBaud(int baud);
@@ -185,6 +193,12 @@ class Simulator {
   Clock::time_point nextRotation_;
   Clock::time_point lineFreeAt_;  // when the last output unit's last byte left the line
   std::deque<Output> out_;
+  // Units that have left the line but not yet entered the pty: a real serial port's kernel
+  // buffer holds 640 KB (Linux tty flip buffers, 13 s at 500 kbaud), a pty only ~16 KB (0.3 s),
+  // less than a loaded machine may leave the host's reader unscheduled. They wait here in order
+  // and enter the pty whole, so the host never waits inside a telegram for held-back bytes.
+  std::deque<std::vector<std::uint8_t>> toHost_;
+  std::size_t toHostBytes_ = 0;
   Faults faults_;
   int nakStorm_ = 0;
   Clock::time_point silentUntil_;
