@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdio>
 #include <thread>
+#include <vector>
 
 #include "fusedet/drivers/lms291/protocol.h"
 
@@ -58,13 +59,17 @@ Result<std::optional<StreamEvent>> Link::nextEvent(Clock::time_point deadline) {
   for (;;) {
     if (auto e = reader_.next()) return std::optional<StreamEvent>(std::move(*e));
     if (cancel_ && cancel_->load()) return makeError(std::errc::operation_canceled, "cancelled");
+    // Past the deadline, what has already arrived still counts: a thread descheduled beyond its
+    // deadline must not call a device late that answered in time. Only then is it a timeout.
     const auto now = Clock::now();
-    if (now >= deadline) return std::optional<StreamEvent>();
-    const auto wait = std::min<std::chrono::microseconds>(
-        gap, std::chrono::duration_cast<std::chrono::microseconds>(deadline - now));
+    const bool late = now >= deadline;
+    const auto wait = late ? std::chrono::microseconds(0)
+                           : std::min<std::chrono::microseconds>(
+                                 gap, std::chrono::duration_cast<std::chrono::microseconds>(deadline - now));
     auto n = port_.read(buffer, wait);
     if (!n) return n.error();
     if (*n == 0) {
+      if (late) return std::optional<StreamEvent>();
       if (wait == gap) reader_.expirePending();
       continue;
     }
@@ -82,10 +87,12 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
   // Silence uses up `retries`; a NAK proves the device is listening, so NAKs get their own
   // (bounded) budget: a probe without retries still survives a refused first request.
   int silentAttempts = 0, nakAttempts = 0;
+  std::vector<Clock::time_point> silentSends;  // when the copies that met silence were sent
   for (int attempt = 0; silentAttempts <= o.retries && nakAttempts <= std::max(o.retries, kNakRetries); ++attempt) {
     if (attempt > 0) ++counters_.retries;
     // Line time of the request itself: at 9600 baud a long request takes tens of ms.
     const auto sendTime = std::chrono::microseconds(static_cast<std::int64_t>(byteSeconds(port_.baud()) * 1e6 * bytes.size()));
+    const auto sentAt = Clock::now();
     if (auto w = port_.write(bytes, std::chrono::seconds(1) + sendTime); !w) return w.error();
     spdlog::trace("lms291 {}: sent 0x{:02X} ({} bytes) at {} baud, attempt {}", port_.path(), command, bytes.size(),
                   port_.baud(), attempt + 1);
@@ -97,6 +104,7 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
       if (!*ev) {
         ++counters_.timeouts;
         ++silentAttempts;
+        silentSends.push_back(sentAt);
         break;
       }
       const StreamEvent& e = **ev;
@@ -112,7 +120,13 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
         break;
       } else if (e.kind == StreamEvent::Kind::kTelegram) {
         const std::uint8_t c = e.telegram.command;
-        if (c == expected || o.acceptAnyTelegram) return e.telegram;
+        if (c == expected || o.acceptAnyTelegram) {
+          if (c == expected && !silentSends.empty()) {
+            silentSends.push_back(sentAt);
+            takeLateAnswers(expected, silentSends, o);
+          }
+          return e.telegram;
+        }
         if (c == kUnknownCommandReply)
         {
           char what[64];
@@ -129,6 +143,36 @@ Result<Telegram> Link::request(std::uint8_t command, std::span<const std::uint8_
   std::snprintf(what, sizeof what, "no reply to command 0x%02X (%d silent, %d refused with NAK)", command,
                 silentAttempts, nakAttempts);
   return makeError(std::errc::timed_out, what);
+}
+
+// A copy sent again after silence may have reached a device that was late, not deaf: it answers
+// every copy (ACK, reply) in order. The answer just taken is then the first copy's, `latency`
+// after it was sent, and the others follow like the copies were sent (`copies`: send times, the
+// answered attempt last). They are taken here (counted lateAnswers), so that the next request with
+// the same reply code does not mistake one for its own. A copy whose ACK has not come twice its
+// latency after it was sent was lost (as are the copies after it): that costs one such wait.
+void Link::takeLateAnswers(std::uint8_t expected, const std::vector<Clock::time_point>& copies, const RequestOptions& o) {
+  const auto latency = std::max<Clock::duration>(Clock::now() - copies.front(), o.ackTimeout);
+  for (std::size_t k = 1; k < copies.size(); ++k) {
+    auto deadline = copies[k] + 2 * latency;
+    bool acked = false;
+    for (;;) {
+      auto ev = nextEvent(deadline);
+      if (!ev || !*ev) return;  // not answered: lost on the way, and so are the copies after it
+      const StreamEvent& e = **ev;
+      if (e.kind == StreamEvent::Kind::kNakByte) break;  // refused: no reply follows
+      if (e.kind == StreamEvent::Kind::kAckByte && !acked) {
+        acked = true;
+        deadline = Clock::now() + o.replyTimeout;
+      } else if (e.kind == StreamEvent::Kind::kTelegram) {
+        if (e.telegram.command == expected) {
+          ++counters_.lateAnswers;
+          break;
+        }
+        ++counters_.passedOver;
+      }
+    }
+  }
 }
 
 Result<Telegram> Link::receive(std::chrono::microseconds timeout) {

@@ -68,6 +68,9 @@ class LmsSim : public ::testing::Test {
     c.baud = baud;
     c.variant = v;
     c.baudSwitchPause = 50ms;
+    // A real LMS ACKs within 60 ms; the simulator is a thread that a loaded 2-core machine can
+    // leave unscheduled for longer than stop()'s two 100 ms ACK waits (a bounded shutdown).
+    c.ackTimeout = 300ms;
     return c;
   }
   std::string dir_, link_;
@@ -547,7 +550,48 @@ TEST_F(LmsSim, Termios2PathAt500k) {
   EXPECT_TRUE(lms.link().usedTermios2());
   EXPECT_EQ(sim_->state().hostBaud, 500000);
   EXPECT_TRUE(lms.readScan(1000ms));
-  EXPECT_TRUE(lms.stop());
+  auto stopped = lms.stop();
+  EXPECT_TRUE(stopped) << stopped.error().message() << "; link: " << lms.counters().link.timeouts << " timeouts, "
+                       << lms.counters().link.retries << " retries, " << lms.counters().link.passedOver << " passed over";
+}
+
+// A device that answers late (ACK 250 ms after a request; the host resends after 100 ms) answers
+// every copy. The next request with the same reply code must get its own reply, not the late
+// answer to a copy of the previous one: variant 100 deg is asked (sent up to three times), then
+// 180 deg, and the second reply must report 180 deg.
+TEST_F(LmsSim, LateAnswersToResentCopiesAreNotTakenForTheNextReply) {
+  sim::SimOptions o;
+  startSim(o);
+  Lms291 lms(config(500000, {180, 100}));
+  auto started = lms.start();
+  ASSERT_TRUE(started) << started.error().message();
+  RequestOptions ro;
+  ro.ackTimeout = 100ms;
+  ro.replyTimeout = 1000ms;
+  ro.retries = 10;  // copies every ~100 ms: the 250 ms ACK arrives during the third
+  const std::uint8_t monitoring[] = {0x25};
+  ASSERT_TRUE(lms.link().request(static_cast<std::uint8_t>(Command::kSwitchMode), monitoring, ro));  // no scans between
+  sim::Faults late;
+  late.ackDelay = 250ms;
+  sim_->setFaults(late);
+  const auto before = lms.counters().link;
+  auto first = lms.link().request(static_cast<std::uint8_t>(Command::kSetVariant), variantPayload({100, 100}), ro);
+  auto second = lms.link().request(static_cast<std::uint8_t>(Command::kSetVariant), variantPayload({180, 100}), ro);
+  sim_->setFaults({});
+  ASSERT_TRUE(first) << first.error().message();
+  ASSERT_TRUE(second) << second.error().message();
+  ASSERT_EQ(first->data.size(), 5u);
+  ASSERT_EQ(second->data.size(), 5u);
+  EXPECT_EQ(u16(first->data, 1), 100);
+  EXPECT_EQ(u16(second->data, 1), 180) << "the second request took a late answer to the first";
+  const auto k = lms.counters().link;
+  std::printf("late device: %llu copies sent again, %llu late answers taken, %llu passed over; simulator: %llu requests\n",
+              (unsigned long long)(k.retries - before.retries), (unsigned long long)(k.lateAnswers - before.lateAnswers),
+              (unsigned long long)(k.passedOver - before.passedOver), (unsigned long long)sim_->counters().requests);
+  EXPECT_LE(k.lateAnswers - before.lateAnswers, k.retries - before.retries);
+  auto stopped = lms.stop();
+  EXPECT_TRUE(stopped) << stopped.error().message();
+  EXPECT_EQ(sim_->state().baud, 9600);
 }
 
 TEST_F(LmsSim, BytesAtTheWrongSpeedAreIgnoredAndScanStampsAccountForLineTime) {

@@ -10,6 +10,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "fusedet/core/result.h"
 #include "fusedet/drivers/lms291/protocol.h"
@@ -32,6 +33,7 @@ struct LinkCounters {
   std::uint64_t timeouts = 0;     // ACK or reply missing, or no telegram within a read timeout
   std::uint64_t naks = 0;         // requests the device refused with NAK
   std::uint64_t passedOver = 0;   // telegrams that arrived while waiting for another reply
+  std::uint64_t lateAnswers = 0;  // replies of a late device to copies of a request sent again
 };
 
 struct RequestOptions {
@@ -71,6 +73,9 @@ class Link {
  private:
   // Next stream event before `deadline`; an empty optional = deadline passed.
   Result<std::optional<StreamEvent>> nextEvent(std::chrono::steady_clock::time_point deadline);
+  // After a reply: takes the answers of a late device to the copies sent at `copies` (retries).
+  void takeLateAnswers(std::uint8_t expected, const std::vector<std::chrono::steady_clock::time_point>& copies,
+                       const RequestOptions& o);
 
   SerialPort port_;
   TelegramReader reader_{Direction::kFromDevice};
