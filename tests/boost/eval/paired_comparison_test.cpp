@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "../random_edits.h"
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/outcomes_file.h"
 #include "fusedet/boost/paired_comparison.h"
@@ -281,18 +282,7 @@ TEST(OutcomesFile, TruncatedAndFuzzedFilesNeverCrash) {
   std::mt19937 rng(15);
   int parsed = 0, rejected = 0;
   for (int it = 0; it < 3000; ++it) {
-    std::string s = good;
-    const int edits = 1 + int(rng() % 4);
-    for (int e = 0; e < edits; ++e) {
-      const std::size_t p = rng() % s.size();
-      switch (rng() % 4) {
-        case 0: s[p] = char(rng() % 256); break;
-        case 1: s.erase(p, 1 + rng() % 8); break;
-        case 2: s = s.substr(0, p) + "{}[],:\"0-e9.1"[rng() % 13] + s.substr(p); break;
-        default: s.resize(p); break;
-      }
-      if (s.empty()) s.push_back('x');
-    }
+    const std::string s = fuzz::randomlyEdited(good, rng, "{}[],:\"0-e9.1");
     try {
       const RunOutcomes r = outcomesFromText(s, "fuzz.json");
       for (const OutcomeSet& x : r.sets) compareSets(x, x);  // what parses can be compared

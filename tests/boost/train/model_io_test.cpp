@@ -8,6 +8,8 @@
 #include <string>
 #include <unistd.h>
 
+#include "../random_edits.h"
+
 using namespace fusedet;
 using namespace fusedet::boosting;
 
@@ -160,18 +162,7 @@ TEST(ModelIo, FuzzedFilesNeverCrash) {
   std::mt19937 rng(11);
   int loaded = 0, rejected = 0;
   for (int it = 0; it < 3000; ++it) {
-    std::string s = good;
-    const int edits = 1 + int(rng() % 4);
-    for (int e = 0; e < edits; ++e) {
-      const std::size_t p = rng() % s.size();
-      switch (rng() % 4) {
-        case 0: s[p] = char(rng() % 256); break;
-        case 1: s.erase(p, 1 + rng() % 8); break;
-        case 2: s = s.substr(0, p) + "{}[],:\"0-e9."[rng() % 12] + s.substr(p); break;
-        default: s.resize(p); break;
-      }
-      if (s.empty()) s.push_back('x');
-    }
+    const std::string s = fuzz::randomlyEdited(good, rng, "{}[],:\"0-e9.");
     try {
       modelFromText(s, "fuzz.json");
       ++loaded;
