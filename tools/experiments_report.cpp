@@ -303,8 +303,9 @@ std::string renderMarkdown(const ExperimentReport& r) {
 
   if (!r.misses.empty()) {
     md << "## Where the missed positives are lost\n\n"
-          "Every positive of the `all` configuration's held-out frames that no detection hits, classified by the "
-          "first step that lost it (boosting::analyseMisses, miss_analysis.h), with the class's hit overlap "
+          "Every positive of the `all` configuration's held-out frames that no detection hits (and, in the rows "
+          "\"on its own training frames\", every (fold, positive) pair of the learning curve's folds that the fold's "
+          "cascade misses on the frames it was trained on), classified by the first step that lost it (boosting::analyseMisses, miss_analysis.h), with the class's hit overlap "
           "(IoU below): **scan geometry** - no window the scan visits (window aspect, minimum size, scale step, "
           "position step, image border) reaches that IoU with it; **grouping** - such a window is accepted by the "
           "cascade but grouping drops it (too few neighbours, inside a bigger group) or merges it into a detection "

@@ -154,23 +154,26 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
         if (spec.analyseMisses) out.positives[i] = untrainedOutcomes(testItems[i].labels, match);
       }
       if (spec.scoreTrainingItems)
-        for (std::size_t i : fold.train)
+        for (std::size_t i : fold.train) {
           out.trainingFrames.push_back(frameOutcome({}, matchDetections({}, testItems[i].labels, match)));
+          if (spec.analyseMisses) out.trainingPositives.push_back(untrainedOutcomes(testItems[i].labels, match));
+        }
       continue;
     }
     std::vector<const Detector*> chain;
     for (const Detector& d : detectors) chain.push_back(&d);
     const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, setup);
     for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
+    // The analysis detects on its own; it must see exactly what the evaluation saw.
+    const auto explain = [&](const DatasetItem& item, const StackMatch& evaluated) {
+      FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, setup);
+      if (a.match.hits != evaluated.hits || a.match.falseAlarms != evaluated.falseAlarms)
+        throw std::logic_error("crossValidate: the miss analysis detected differently from the evaluation on " + item.id);
+      return std::move(a.positives);
+    };
     if (spec.analyseMisses)
-      for (std::size_t k = 0; k < fold.test.size(); ++k) {
-        const DatasetItem& item = testItems[fold.test[k]];
-        FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, setup);
-        if (a.match.hits != eval.matches[k].hits || a.match.falseAlarms != eval.matches[k].falseAlarms)
-          throw std::logic_error("crossValidate: the miss analysis detected differently from the evaluation on " +
-                                 item.id);
-        out.positives[fold.test[k]] = std::move(a.positives);
-      }
+      for (std::size_t k = 0; k < fold.test.size(); ++k)
+        out.positives[fold.test[k]] = explain(testItems[fold.test[k]], eval.matches[k]);
     out.summaries.push_back(parts.size() == 1 ? parts.front() : combineSummaries(parts));
     detectMs += eval.msPerStack * static_cast<double>(fold.test.size());
     detected += fold.test.size();
@@ -178,6 +181,9 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     if (spec.scoreTrainingItems) {
       const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, setup);
       out.trainingFrames.insert(out.trainingFrames.end(), own.frames.begin(), own.frames.end());
+      if (spec.analyseMisses)
+        for (std::size_t k = 0; k < fold.train.size(); ++k)
+          out.trainingPositives.push_back(explain(testItems[fold.train[k]], own.matches[k]));
       trainHits = own.counts.hits;
       trainFalseAlarms = own.counts.falseAlarms;
       trainPositives = own.counts.positives;

@@ -68,6 +68,9 @@ struct CrossValidationResult {
   std::vector<FrameOutcome> trainingFrames;
   // Per item, what became of each positive (ChainSpec::analyseMisses, one-cascade chains only).
   std::vector<std::vector<PositiveOutcome>> positives;
+  // With both analyseMisses and scoreTrainingItems: the same per (fold, training item), in the
+  // order of trainingFrames - where a cascade loses the objects it was trained on.
+  std::vector<std::vector<PositiveOutcome>> trainingPositives;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -80,8 +83,8 @@ struct ChainSpec {
   // items' labels as the test items hold them): the training score beside the held-out one that
   // tells a data limit (high on training, low held out) from a method limit (low on both).
   bool scoreTrainingItems = false;
-  // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives;
-  // needs a chain of one cascade.
+  // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives
+  // (and, with scoreTrainingItems, into trainingPositives); needs a chain of one cascade.
   bool analyseMisses = false;
 };
 
