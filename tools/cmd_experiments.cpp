@@ -27,6 +27,7 @@
 #include "experiments_report.h"
 #include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/cascade_trainer.h"
+#include "fusedet/boost/class_detection.h"
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/cross_validation.h"
 #include "fusedet/boost/data_split.h"
@@ -82,6 +83,10 @@ struct ExperimentOptions {
   double nmsIou = 0.5;
   int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
+  // Per-class detection settings (boost/class_detection.h, car) where the preset uses them; an
+  // option given on the command line applies to every class instead.
+  bool classDetection = true;
+  bool minNeighborsGiven = false, laserExtentGiven = false;
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -554,6 +559,28 @@ int runExperiments(ExperimentOptions o) {
   setup.scan.threads = 1;  // ms per stack on one core, comparable across configurations
   setup.group = groupParams(o);
   setup.laserExtent.enabled = o.laserExtent;
+  // A class's own detection settings (class_detection.h) where the preset uses them, unless the
+  // command line set that option for every class.
+  const bool perClass = preset.classDetection && o.classDetection;
+  const auto setupFor = [&](const std::string& cls) {
+    boosting::DetectionSetup s = setup;
+    const std::optional<boosting::ClassDetection> own = perClass ? boosting::classDetectionDefault(cls) : std::nullopt;
+    if (!own) return s;
+    if (o.scaleFactor <= 0) s.scan.scaleFactor = own->scaleFactor;
+    if (o.step <= 0) s.scan.step = own->step;
+    if (!o.minNeighborsGiven) s.group.minNeighbors = own->minNeighbors;
+    if (!o.laserExtentGiven) s.laserExtent.enabled = own->laserExtent;
+    return s;
+  };
+  std::string perClassText = "none: every class with the settings above";
+  if (perClass)
+    for (const std::string& cls : o.classes)
+      if (boosting::classDetectionDefault(cls)) {
+        const boosting::DetectionSetup s = setupFor(cls);
+        perClassText = (perClassText.rfind("none", 0) == 0 ? "" : perClassText + "; ") + cls + ": scale factor " +
+                       shortNum(s.scan.scaleFactor) + " / step " + shortNum(s.scan.step) + ", min neighbours " +
+                       std::to_string(s.group.minNeighbors) + ", laser extent " + (s.laserExtent.enabled ? "on" : "off");
+      }
 
   report.settings = {
       {"preset", preset.name},
@@ -585,6 +612,7 @@ int runExperiments(ExperimentOptions o) {
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
       {"training scan scale factor / step", shortNum(preset.trainScaleFactor) + " / " + shortNum(preset.trainStep)},
       {"grouping", groupingText(o)},
+      {"per-class detection (boost/class_detection.h; --no-class-detection: none)", perClassText},
       {"laser-extent box refinement (--laser-extent)",
        o.laserExtent ? "on: left/right edges widened to the distance layer's object cluster" : "off"},
       {"contrast-normalised layers", o.contrastNormalise},
@@ -750,10 +778,10 @@ int runExperiments(ExperimentOptions o) {
     boosting::ChainSpec spec = chainFor(o, preset, cls, config, match);
     spec.analyseMisses = o.missAnalysis && config == "all";
     const boosting::CrossValidationResult cv =
-        boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, setup, cache, quiet, log);
+        boosting::crossValidate(spec, trainItemsOf[cls], items, folds, match, setupFor(cls), cache, quiet, log);
     if (spec.analyseMisses)
       report.misses.push_back({cls, config, boosting::summariseMisses(cv.positives), boosting::MissAnalysisConfig{}.localisationIou,
-                               setup.group.minNeighbors, match.minIou});
+                               setupFor(cls).group.minNeighbors, match.minIou});
     ConfigResult r;
     r.className = cls;
     r.config = config;
@@ -815,7 +843,7 @@ int runExperiments(ExperimentOptions o) {
       for (std::size_t stages : o.stageSweep)
         for (int mn : neighbours) {
           spec.keepStages = stages;
-          boosting::DetectionSetup s = setup;
+          boosting::DetectionSetup s = setupFor(cls);
           s.group.minNeighbors = mn;
           s.scan.threads = o.threads;  // nothing is timed here
           const boosting::CrossValidationResult cv =
@@ -890,14 +918,14 @@ int runExperiments(ExperimentOptions o) {
       } else {
         std::printf("%s / all, %s (learning curve, %s):\n", cls.c_str(), what.c_str(), report.learningFolds.c_str());
         const boosting::CrossValidationResult cv =
-            boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setup, cache, quiet, log);
+            boosting::crossValidate(spec, trainItemsOf[cls], items, sub, match, setupFor(cls), cache, quiet, log);
         report.trainSeconds += cv.trainSeconds;
         foldModels.insert(cv.models.begin(), cv.models.end());
         frames = cv.frames;
         if (spec.analyseMisses)
           report.misses.push_back({cls, "all, on its own training frames (" + report.learningFolds + ")",
                                    boosting::summariseMisses(cv.trainingPositives),
-                                   boosting::MissAnalysisConfig{}.localisationIou, setup.group.minNeighbors,
+                                   boosting::MissAnalysisConfig{}.localisationIou, setupFor(cls).group.minNeighbors,
                                    match.minIou});
         if (spec.scoreTrainingItems) {
           p.trainingScored = true;
@@ -1113,7 +1141,10 @@ const bool registered = registerCommand(
       app.add_option("--step", o->step,
                      "detection position step in base-window pixels" +
                          presets(&boosting::ExperimentPlan::step));
-      app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
+      app.add_option("--min-neighbors", o->minNeighbors,
+                     "grouping: hits a detection needs (car: its own where the preset uses per-class detection; "
+                     "given, for every class)")
+          ->capture_default_str();
       app.add_option("--grouping", o->grouping,
                      "grouping of raw hits: opencv (cv::groupRectangles' rule, score = group size) or nms "
                      "(score-based non-maximum suppression, score = last stage sum), as fusedetd's detection.grouping")
@@ -1134,7 +1165,13 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_flag("--laser-extent", o->laserExtent,
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "
-                   "cluster in the distance layer ends (boost/laser_extent.h; default: off)");
+                   "cluster in the distance layer ends (boost/laser_extent.h; default: off, but car's own setting "
+                   "where the preset uses per-class detection); given, it applies to every class");
+      app.add_flag("!--no-class-detection", o->classDetection,
+                   "detect every class with the general settings (--scale-factor, --step, --min-neighbors, "
+                   "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
+                   "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
+                   "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
       app.add_option("--contrast-normalise", o->contrastNormalise,
                      "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
                      "window's standard deviation of their layer): none, camera (red, green, blue, intensity "
@@ -1225,6 +1262,8 @@ const bool registered = registerCommand(
           for (const auto& r : opt->results()) cmd += " " + r;
         }
         o->commandLine = cmd;
+        o->minNeighborsGiven = app.count("--min-neighbors") > 0;
+        o->laserExtentGiven = app.count("--laser-extent") > 0;
         return runExperiments(*o);
       };
     });

@@ -57,6 +57,20 @@ class Section {
 
   YAML::Node at(const char* key) const { return node_ && node_.IsMap() ? node_[key] : YAML::Node(); }
 
+  // The entries of the mapping under `key` (name, its section), in file order; marks `key` read.
+  std::vector<std::pair<std::string, Section>> entries(const char* key) {
+    seen_.insert(key);
+    std::vector<std::pair<std::string, Section>> out;
+    const YAML::Node n = at(key);
+    if (!n || n.IsNull()) return out;
+    if (!n.IsMap()) fail(n, "key " + keyPath(key) + ": expected a mapping");
+    for (const auto& kv : n) {
+      const auto name = kv.first.as<std::string>();
+      out.emplace_back(name, Section(kv.second, keyPath(key) + "." + name, source_));
+    }
+    return out;
+  }
+
   Section child(const char* key) {
     seen_.insert(key);
     return Section(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), keyPath(key), source_);
@@ -189,6 +203,16 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
     s.read("laser_extent", c.detection.laserExtent);
     s.readRange("threads", c.detection.threads, 0, 256);
+    if (s.at("classes")) {  // given: replaces the built-in per-class settings (`classes: {}` = none)
+      c.detection.classes.clear();
+      for (auto& [name, e] : s.entries("classes")) {
+        Config::Detection::ClassSettings k{name, c.detection.minNeighbors, c.detection.laserExtent};
+        e.readRange("min_neighbors", k.minNeighbors, 0, 1000);
+        e.read("laser_extent", k.laserExtent);
+        e.finish();
+        c.detection.classes.push_back(std::move(k));
+      }
+    }
     s.finish();
   }
   {
@@ -296,7 +320,12 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "nms_iou" << YAML::Value << c.detection.nmsIou;
   out << YAML::Key << "min_neighbors" << YAML::Value << c.detection.minNeighbors;
   out << YAML::Key << "laser_extent" << YAML::Value << c.detection.laserExtent;
-  out << YAML::Key << "threads" << YAML::Value << c.detection.threads << YAML::EndMap;
+  out << YAML::Key << "threads" << YAML::Value << c.detection.threads;
+  out << YAML::Key << "classes" << YAML::Value << YAML::BeginMap;
+  for (const auto& k : c.detection.classes)
+    out << YAML::Key << k.name << YAML::Value << YAML::BeginMap << YAML::Key << "min_neighbors" << YAML::Value
+        << k.minNeighbors << YAML::Key << "laser_extent" << YAML::Value << k.laserExtent << YAML::EndMap;
+  out << YAML::EndMap << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << c.replay.file;
   out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime;

@@ -33,8 +33,17 @@ boosting::LaserExtentParams laserExtentFrom(const Config::Detection& d) {
   return p;
 }
 
+std::vector<boosting::ClassGrouping> classGroupingFrom(const Config::Detection& d) {
+  std::vector<boosting::ClassGrouping> out;
+  for (const auto& k : d.classes) out.push_back({k.name, k.minNeighbors, k.laserExtent});
+  return out;
+}
+
 CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem::path& base)
-    : scan_(scanParamsFrom(settings)), group_(groupParamsFrom(settings)), extent_(laserExtentFrom(settings)) {
+    : scan_(scanParamsFrom(settings)),
+      group_(groupParamsFrom(settings)),
+      extent_(laserExtentFrom(settings)),
+      perClass_(classGroupingFrom(settings)) {
   if (settings.models.empty()) throw std::runtime_error("detection.models: no model files configured");
   std::set<std::string> seen;
   std::vector<boosting::Cascade> cascades;
@@ -55,9 +64,7 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
 }
 
 std::vector<Detection> CascadeSet::detect(const LayerStack& stack) const {
-  std::vector<Detection> found = boosting::detect(*detector_, stack, scan_, group_);
-  refineToLaserExtent(found, stack, extent_);
-  return found;
+  return boosting::detectPerClass(*detector_, stack, scan_, group_, extent_, perClass_);
 }
 
 std::vector<std::string> CascadeSet::classes() const {

@@ -132,6 +132,50 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   EXPECT_EQ(g.minNeighbors, glib.minNeighbors);
   EXPECT_EQ(g.iouThreshold, glib.iouThreshold);
   EXPECT_EQ(laserExtentFrom(d).enabled, boosting::LaserExtentParams{}.enabled);
+  // Per class: the built-in list is the library's (car), and the scan fusedet experiments measures
+  // car with is the daemon's, so its docs/results figures are what fusedetd does for car.
+  const std::vector<boosting::ClassGrouping> perClass = classGroupingFrom(d);
+  ASSERT_EQ(perClass.size(), 1u);
+  for (const boosting::ClassGrouping& k : perClass) {
+    const std::optional<boosting::ClassDetection> own = boosting::classDetectionDefault(k.className);
+    ASSERT_TRUE(own.has_value()) << k.className;
+    EXPECT_EQ(k.minNeighbors, own->minNeighbors);
+    EXPECT_EQ(k.laserExtent, own->laserExtent);
+    EXPECT_EQ(own->scaleFactor, s.scaleFactor);
+    EXPECT_EQ(own->step, s.step);
+  }
+  for (const char* other : {"person", "bike"}) EXPECT_FALSE(boosting::classDetectionDefault(other).has_value());
+}
+
+// detection.classes: each entry inherits the general min_neighbors / laser_extent it leaves out;
+// given, the list replaces the built-in one ({} = none); unknown keys are named.
+TEST(DetectionSettings, PerClassKeys) {
+  const Config c = parseConfig(
+      "detection:\n  min_neighbors: 2\n  laser_extent: true\n  classes:\n    person: {min_neighbors: 7}\n"
+      "    car: {laser_extent: false}\n",
+      "test.yaml");
+  const std::vector<boosting::ClassGrouping> k = classGroupingFrom(c.detection);
+  ASSERT_EQ(k.size(), 2u);
+  EXPECT_EQ(k[0].className, "person");
+  EXPECT_EQ(k[0].minNeighbors, 7);
+  EXPECT_TRUE(k[0].laserExtent);
+  EXPECT_EQ(k[1].className, "car");
+  EXPECT_EQ(k[1].minNeighbors, 2);
+  EXPECT_FALSE(k[1].laserExtent);
+  const Config back = parseConfig(dumpConfig(c), "dump.yaml");
+  EXPECT_EQ(dumpConfig(back), dumpConfig(c));
+  ASSERT_EQ(back.detection.classes.size(), 2u);
+  EXPECT_EQ(back.detection.classes[0].minNeighbors, 7);
+  EXPECT_TRUE(parseConfig("detection:\n  classes: {}\n", "t.yaml").detection.classes.empty());
+  EXPECT_EQ(parseConfig("detection:\n  min_neighbors: 5\n", "t.yaml").detection.classes.size(), 1u);
+  try {
+    (void)parseConfig("detection:\n  classes:\n    car: {neighbours: 3}\n", "t.yaml");
+    ADD_FAILURE() << "an unknown per-class key was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key detection.classes.car.neighbours"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)parseConfig("detection:\n  classes: [car]\n", "t.yaml"), ConfigError);
+  EXPECT_THROW((void)parseConfig("detection:\n  classes:\n    car: {min_neighbors: -1}\n", "t.yaml"), ConfigError);
 }
 
 // Non-default values written in fusedet.yaml reach the library unchanged, in its units: step in

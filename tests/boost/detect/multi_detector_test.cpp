@@ -4,6 +4,7 @@
 // fused from ../shared/data with the bundled models: the same hits, scores, order and work.
 
 #include "fusedet/boost/multi_detector.h"
+#include "fusedet/boost/class_detection.h"
 
 #include <gtest/gtest.h>
 
@@ -331,6 +332,52 @@ TEST(MultiDetector, GroupsEachClassUnderItsName) {
       EXPECT_EQ(d[i].score, want[i].score);
     }
   }
+}
+
+// detectPerClass(): each class grouped and box-refined with its own settings, the others with the
+// general ones - against each class's own Detector, grouped and refined here.
+TEST(MultiDetector, DetectPerClassUsesEachClassesOwnGroupingAndLaserExtent) {
+  const MultiDetector all(bundledModels());
+  ScanParams p;
+  p.threads = 2;
+  GroupParams g;  // general: 3 neighbours
+  LaserExtentParams off;
+  LaserExtentParams on;
+  on.enabled = true;
+  const std::vector<ClassGrouping> own{{"car", 1, true}};
+  std::size_t refined = 0, carDetections = 0;
+  for (const LayerStack& s : kittiStacks()) {
+    // Nothing per class: the general rule for every model.
+    const std::vector<Detection> plain = detectPerClass(all, s, p, g, off, {});
+    const std::vector<Detection> general = detect(all, s, p, g);
+    ASSERT_EQ(plain.size(), general.size());
+    for (std::size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(plain[i].box, general[i].box);
+
+    const std::vector<Detection> d = detectPerClass(all, s, p, g, off, own);
+    std::vector<Detection> want;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const bool car = all.cascade(i).className == "car";
+      GroupParams gi = g;
+      if (car) gi.minNeighbors = 1;
+      std::vector<Detection> one = detect(Detector(all.cascade(i)), s, p, gi);
+      if (car) {
+        const std::vector<Detection> before = one;
+        refineToLaserExtent(one, s, on);
+        for (std::size_t k = 0; k < one.size(); ++k) refined += one[k].box == before[k].box ? 0 : 1;
+        carDetections += one.size();
+      }
+      want.insert(want.end(), one.begin(), one.end());
+    }
+    ASSERT_EQ(d.size(), want.size()) << s.source;
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      EXPECT_EQ(d[i].className, want[i].className);
+      EXPECT_EQ(d[i].box, want[i].box) << s.source << " detection " << i;
+      EXPECT_EQ(d[i].score, want[i].score);
+    }
+  }
+  // Not vacuous: car's single-window groups exist and the laser moved some of their edges.
+  EXPECT_GT(carDetections, 0u);
+  EXPECT_GT(refined, 0u);
 }
 
 TEST(MultiDetector, MissingLayerIsNamed) {

@@ -34,8 +34,10 @@ struct ExperimentPlan {
   std::size_t negatives = 0;  // 0 = the trainer's rule, max(500, 2 x positives)
   double trainScaleFactor = 1.2, trainStep = 3;
   int validationPart = 0;  // 0 = off (validation_part.h)
-  // Detection on the test frames.
+  // Detection on the test frames; with classDetection a class that has its own settings
+  // (class_detection.h: car) is detected with those instead.
   double scaleFactor = 1.2, step = 3;
+  bool classDetection = true;
   // Folds of the headline and the configurations: 0 = leave-one-drive-out, k = k drive-disjoint
   // folds (data_split.h crossGroupFolds).
   int folds = 0;

@@ -2,7 +2,8 @@
 // Laser-extent box refinement: a detection's left and right edges moved outwards to where the
 // object's cluster in the `distance` layer ends. The cascade scans one window aspect (car 36x24 =
 // 1.5) and its groups average windows, so a car box is often too narrow at the KITTI devkit's
-// IoU 0.7; the laser sees the object's extent. Off by default: car F at IoU 0.7 rises from 0.43
+// IoU 0.7; the laser sees the object's extent. Off in the general settings (car uses it with its
+// own scan and neighbours: class_detection.h); alone, car F at IoU 0.7 rises from 0.43
 // to 0.49 on 3 drive-disjoint folds but only from 0.51 to 0.53 leave-one-drive-out (+4 hits of
 // 186; paired interval of the difference +0.02 [-0.005, 0.05]: a tie across drives; `fusedet
 // compare`, boost/README.md).

@@ -86,6 +86,14 @@ struct Config {
     int minNeighbors = 3;
     bool laserExtent = false;  // boosting::LaserExtentParams::enabled
     int threads = 0;
+    // Per class, its own min_neighbors and laser_extent over the two above (same scan); the
+    // default is boosting::classDetectionDefault()'s (car). A config's `classes:` replaces it.
+    struct ClassSettings {
+      std::string name;
+      int minNeighbors = 3;
+      bool laserExtent = false;
+    };
+    std::vector<ClassSettings> classes{{"car", 16, true}};
   } detection;
 
   struct Replay {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fusedet/boost/class_detection.h"
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"
@@ -30,6 +31,7 @@ class StackDetector {
 boosting::ScanParams scanParamsFrom(const Config::Detection& d);
 boosting::GroupParams groupParamsFrom(const Config::Detection& d);
 boosting::LaserExtentParams laserExtentFrom(const Config::Detection& d);
+std::vector<boosting::ClassGrouping> classGroupingFrom(const Config::Detection& d);  // detection.classes
 
 class CascadeSet : public StackDetector {
  public:
@@ -47,6 +49,7 @@ class CascadeSet : public StackDetector {
   boosting::ScanParams scan_;
   boosting::GroupParams group_;
   boosting::LaserExtentParams extent_;  // detection.laser_extent
+  std::vector<boosting::ClassGrouping> perClass_;  // detection.classes
 };
 
 }  // namespace fusedet::daemon
