@@ -35,9 +35,9 @@ Tally tally(const Detector& det, const DatasetItem& item, const DetectionSetup& 
   return t;
 }
 
-TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
-  // Drive "empty": 2 scenes without cars; drive "full": 10 scenes, 2 cars in most. DontCare
-  // regions are dropped so that the hand-written matching above is the devkit's here.
+// Drive "empty": 2 scenes without cars; drive "full": 10 scenes, 2 cars in most. DontCare
+// regions are dropped so that the hand-written matching above is the devkit's here.
+std::vector<DatasetItem> twoDrives() {
   std::vector<DatasetItem> items;
   for (unsigned s = 0; s < 12; ++s) {
     DatasetItem it = synthetic::scene(300 + s, s < 2 ? 0 : 2, false);
@@ -45,18 +45,38 @@ TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
     std::erase_if(it.labels, [](const Label& l) { return l.ignore; });
     items.push_back(std::move(it));
   }
-  std::vector<std::string> groups;
-  for (const auto& it : items) groups.push_back(it.group);
-  const std::vector<Fold> folds = crossGroupFolds(groups);  // tests "empty", then "full"
-  ASSERT_EQ(folds.size(), 2u);
+  return items;
+}
+
+// Cars of 20 px and more, no ignore rules; every window position, single-window groups kept.
+MatchConfig carMatch() {
   MatchConfig match;
   match.className = "car";
   match.minHeight = 20;
   match.minDetectionHeight = 0;
+  return match;
+}
+
+DetectionSetup fineSetup() {
   DetectionSetup setup;
   setup.scan.scaleFactor = 1.1;
   setup.scan.step = 1;
   setup.group.minNeighbors = 1;
+  return setup;
+}
+
+std::vector<Fold> foldsOf(const std::vector<DatasetItem>& items) {
+  std::vector<std::string> groups;
+  for (const auto& it : items) groups.push_back(it.group);
+  return crossGroupFolds(groups);
+}
+
+TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
+  const std::vector<DatasetItem> items = twoDrives();
+  const std::vector<Fold> folds = foldsOf(items);  // tests "empty", then "full"
+  ASSERT_EQ(folds.size(), 2u);
+  const MatchConfig match = carMatch();
+  const DetectionSetup setup = fineSetup();
   TrainingConfig config = synthetic::smallConfig();
   config.threads = 1;
   ChainSpec spec{{config}};
@@ -109,26 +129,12 @@ TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
 
 TEST(TrainingScore, MissAnalysisOfTheOwnTrainingItems) {
   // As above: "empty" (2 car-free scenes) cannot train, "full" (10 scenes, 2 cars each) can.
-  std::vector<DatasetItem> items;
-  for (unsigned s = 0; s < 12; ++s) {
-    DatasetItem it = synthetic::scene(300 + s, s < 2 ? 0 : 2, false);
-    it.group = s < 2 ? "empty" : "full";
-    std::erase_if(it.labels, [](const Label& l) { return l.ignore; });
-    items.push_back(std::move(it));
-  }
-  std::vector<std::string> groups;
-  for (const auto& it : items) groups.push_back(it.group);
-  std::vector<Fold> folds = crossGroupFolds(groups);  // fold 0 trains on "full", tests "empty"
+  const std::vector<DatasetItem> items = twoDrives();
+  std::vector<Fold> folds = foldsOf(items);  // fold 0 trains on "full", tests "empty"
   ASSERT_EQ(folds.size(), 2u);
   std::swap(folds[0], folds[1]);  // the untrainable fold first: its outcomes must come first too
-  MatchConfig match;
-  match.className = "car";
-  match.minHeight = 20;
-  match.minDetectionHeight = 0;
-  DetectionSetup setup;
-  setup.scan.scaleFactor = 1.1;
-  setup.scan.step = 1;
-  setup.group.minNeighbors = 1;
+  const MatchConfig match = carMatch();
+  const DetectionSetup setup = fineSetup();
   TrainingConfig config = synthetic::smallConfig();
   config.threads = 1;
   ChainSpec spec{{config}};
