@@ -13,6 +13,7 @@
 #include "command.h"
 #include "data_dir.h"
 #include "fusedet/boost/data_split.h"
+#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/model_io.h"
@@ -55,12 +56,12 @@ void detectWithModels(const std::filesystem::path& dir, const LayerStack& stack,
   const boosting::MultiDetector detector(std::move(models));
   // Every class in one pass over the stack (shared integrals, one pool of work for the threads).
   const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<std::vector<boosting::RawHit>> hits = detector.scan(stack, scan);
+  const std::vector<std::vector<std::vector<boosting::RawHit>>> hits = detector.scanModels(stack, scan);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::printf("detect    %zu classes in one pass: %.1f ms\n", detector.size(), ms);
   for (std::size_t i = 0; i < detector.size(); ++i) {
     const auto& c = detector.cascade(i);
-    const std::vector<Detection> found = boosting::groupHits(hits[i], group, c.className, stack);
+    const std::vector<Detection> found = boosting::groupModelHits(c, hits[i], group, stack);
     std::printf("detect    %-7s %s: %zu stages, %zu detections\n", c.className.c_str(),
                 files[i].filename().string().c_str(), c.stages.size(), found.size());
     for (const Detection& d : found) {

@@ -12,6 +12,7 @@
 #include <regex>
 
 #include "command.h"
+#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"
@@ -138,8 +139,11 @@ int runDetect(const DetectOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   ScanStats stats;
-  const std::vector<RawHit> hits = detector.scan(stack, scan, &stats);
-  std::vector<Detection> dets = groupHits(hits, group, c.className, stack);
+  // The model's aspect cascades too, merged by the one rule (aspect_cascades.h).
+  const std::vector<std::vector<RawHit>> perCascade = scanModel(detector, stack, scan, &stats);
+  std::vector<Detection> dets = groupModelHits(c, perCascade, group, stack);
+  std::size_t rawHits = 0;
+  for (const auto& h : perCascade) rawHits += h.size();
   LaserExtentParams extent;
   extent.enabled = o.laserExtent;
   refineToLaserExtent(dets, stack, extent);
@@ -147,7 +151,7 @@ int runDetect(const DetectOptions& o) {
 
   std::printf("%s on %s (%dx%d): %zu windows at %zu scales, %zu raw hits, %zu detections, %.1f ms\n",
               o.model.filename().string().c_str(), (o.image.empty() ? o.stack : o.image).string().c_str(),
-              stack.width(), stack.height(), stats.windows, stats.scales, hits.size(), dets.size(), ms);
+              stack.width(), stack.height(), stats.windows, stats.scales, rawHits, dets.size(), ms);
   for (const Detection& d : dets)
     std::printf("  %s score %.4g  x %.0f y %.0f w %.0f h %.0f\n", d.className.c_str(), d.score, d.box.x, d.box.y,
                 d.box.w, d.box.h);

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "command.h"
+#include "side_view_options.h"
 #include "mpi_job.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/chain_evaluation.h"
@@ -51,6 +52,7 @@ struct TrainOptions {
   bool minHeightFromPositives = false;
   bool softCascade = false;
   std::string softStartWeights = "margin";
+  boosting::TrainingConfig::SideView sideView;  // off by default
   bool vanNegative = false;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
@@ -217,6 +219,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.minHeightFromPositives = o.minHeightFromPositives;
   c.softCascade = o.softCascade;
   c.stage.marginStartWeights = o.softStartWeights == "margin";
+  c.sideView = o.sideView;
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
@@ -315,6 +318,12 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
   if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
+  if (c.sideView.minAspect > 0)
+    info.emplace_back("side_view", cascade.aspectCascades.empty()
+                                       ? "none trained (too few positives with w/h >= " + std::to_string(o.sideView.minAspect) + ")"
+                                       : "positives w/h >= " + std::to_string(o.sideView.minAspect) + ", window " +
+                                             std::to_string(cascade.aspectCascades[0].windowWidth) + "x" +
+                                             std::to_string(cascade.aspectCascades[0].windowHeight));
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
                                              std::to_string(report.validationItems) + " items, " +
@@ -419,6 +428,7 @@ const bool registered = registerCommand(
                      "the sums and thresholds carry the earlier stages)")
           ->check(CLI::IsMember({"margin", "uniform"}))
           ->capture_default_str();
+      addSideViewOptions(app, o->sideView);
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
                    "negative windows on them)");

@@ -18,6 +18,7 @@ Cascade firstStages(Cascade cascade, std::size_t stages) {
   if (stages == 0) throw std::invalid_argument("firstStages: a cascade keeps at least one stage");
   if (cascade.stages.size() > stages) cascade.stages.resize(stages);
   if (cascade.treeStages.size() > stages) cascade.treeStages.resize(stages);
+  for (Cascade& a : cascade.aspectCascades) a = firstStages(std::move(a), stages);
   return cascade;
 }
 
@@ -74,6 +75,19 @@ void Cascade::validate() const {
     }
   }
   if (soft && isOpenCv()) fail("an imported OpenCV cascade cannot be a soft cascade");
+  if (isOpenCv() && !aspectCascades.empty()) fail("an imported OpenCV cascade cannot hold aspect cascades");
+  for (std::size_t i = 0; i < aspectCascades.size(); ++i) {
+    const Cascade& a = aspectCascades[i];
+    const std::string at = "aspect cascade " + std::to_string(i);
+    if (a.className != className) fail(at + " is of class '" + a.className + "', not '" + className + "'");
+    if (a.isOpenCv()) fail(at + " is an OpenCV cascade");
+    if (!a.aspectCascades.empty()) fail(at + " holds aspect cascades itself");
+    try {
+      a.validate();
+    } catch (const std::invalid_argument& e) {
+      fail(at + ": " + e.what());
+    }
+  }
   const bool trees = hasTrees();
   if (trees && !isOpenCv()) fail("decision trees are only supported in imported OpenCV cascades");
   if (trees && treeStages.size() != stages.size())

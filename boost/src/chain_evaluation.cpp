@@ -4,6 +4,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/integral_stack.h"
 
 namespace fusedet::boosting {
@@ -12,6 +13,13 @@ std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, co
                                    const DetectionSetup& setup, ScanStats* stats) {
   if (chain.empty()) throw std::invalid_argument("detectChain: no cascade given");
   const Detector& first = *chain.front();
+  if (!first.cascade().aspectCascades.empty()) {
+    if (chain.size() > 1) throw std::invalid_argument(first.cascade().source + ": a model with aspect cascades cannot be AND-combined");
+    std::vector<Detection> dets =
+        groupModelHits(first.cascade(), scanModel(first, stack, setup.scan, stats), setup.group, stack);
+    refineToLaserExtent(dets, stack, setup.laserExtent);
+    return dets;
+  }
   std::vector<RawHit> hits = first.scan(stack, setup.scan, stats);
   for (std::size_t k = 1; k < chain.size() && !hits.empty(); ++k) {
     const Cascade& c = chain[k]->cascade();

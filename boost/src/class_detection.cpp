@@ -1,5 +1,7 @@
 #include "fusedet/boost/class_detection.h"
 
+#include "fusedet/boost/aspect_cascades.h"
+
 #include <algorithm>
 #include <iterator>
 
@@ -20,7 +22,8 @@ std::optional<ClassDetection> classDetectionDefault(const std::string& className
 std::vector<Detection> detectPerClass(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                                       const GroupParams& group, const LaserExtentParams& extent,
                                       const std::vector<ClassGrouping>& perClass) {
-  const std::vector<std::vector<RawHit>> hits = detector.scan(stack, scan);
+  // Every model's cascades, aspect cascades included, merged per model (aspect_cascades.h).
+  const std::vector<std::vector<std::vector<RawHit>>> hits = detector.scanModels(stack, scan);
   std::vector<Detection> out;
   for (std::size_t i = 0; i < hits.size(); ++i) {
     const std::string& name = detector.cascade(i).className;
@@ -32,7 +35,7 @@ std::vector<Detection> detectPerClass(const MultiDetector& detector, const Layer
       g.minNeighbors = own->minNeighbors;
       e.enabled = own->laserExtent;
     }
-    std::vector<Detection> d = groupHits(hits[i], g, name, stack);
+    std::vector<Detection> d = groupModelHits(detector.cascade(i), hits[i], g, stack);
     refineToLaserExtent(d, stack, e);
     out.insert(out.end(), std::make_move_iterator(d.begin()), std::make_move_iterator(d.end()));
   }

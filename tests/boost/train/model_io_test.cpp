@@ -216,7 +216,7 @@ TEST(ModelIo, BadContrastNormalisedFieldIsAClearError) {
                 .find("contrast_normalised[2]: layer 'intensity' listed twice"),
             std::string::npos);
   EXPECT_NE(with("{\"intensity\": true}").find("expected an array, got object"), std::string::npos);
-  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 4")).find("unsupported version 4 (this build reads 1 to 3)"),
+  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 5")).find("unsupported version 5 (this build reads 1 to 4)"),
             std::string::npos);
   // Invalid in memory: flags of the wrong size.
   c.contrastNormalised = {true};
@@ -327,5 +327,113 @@ TEST(ModelIo, FuzzedCascadeKindNeverCrashes) {
   }
   EXPECT_GT(rejected, 0);
   EXPECT_GT(soft, 0);
+  EXPECT_EQ(loaded + rejected, 2000);
+}
+
+// Aspect cascades (cascade.h, e.g. a side-view car cascade): format version 4, "aspect_cascades"
+// holds model objects of their own; a model without them is written as before.
+namespace {
+Cascade sideView() {
+  Cascade a;
+  a.className = "car";
+  a.windowWidth = 58;
+  a.windowHeight = 24;
+  a.layers = {"distance"};
+  const int f = a.addFeature(Feature{FeatureType::kEdgeVertical, Box{0, 0, 0.5, 1}, 0});
+  a.stages.push_back(Stage{{Stump{f, 2.5, -1, 1}}, 0.25});
+  return a;
+}
+}  // namespace
+
+TEST(ModelIo, AspectCascadesRoundTripAsVersion4) {
+  const std::string plain = modelToText(sample());
+  EXPECT_NE(plain.find("\"version\": 1"), std::string::npos);
+  EXPECT_EQ(plain.find("aspect_cascades"), std::string::npos);
+  Cascade c = sample();
+  c.aspectCascades.push_back(sideView());
+  const std::string text = modelToText(c);
+  EXPECT_NE(text.find("\"version\": 4"), std::string::npos);
+  const Cascade back = modelFromText(text, "m.json");
+  Cascade first = back;
+  first.aspectCascades.clear();
+  EXPECT_EQ(modelToText(first), plain);  // the first cascade read back unchanged
+  ASSERT_EQ(back.aspectCascades.size(), 1u);
+  const Cascade& a = back.aspectCascades[0];
+  EXPECT_EQ(a.windowWidth, 58);
+  EXPECT_EQ(a.windowHeight, 24);
+  EXPECT_EQ(a.layers, std::vector<std::string>{"distance"});
+  ASSERT_EQ(a.stages.size(), 1u);
+  EXPECT_EQ(a.stages[0].threshold, 0.25);
+  EXPECT_EQ(a.stages[0].stumps[0].threshold, 2.5);
+  EXPECT_EQ(a.features[0].type, FeatureType::kEdgeVertical);
+  EXPECT_EQ(a.source, "m.json");
+  EXPECT_EQ(modelToText(back), text);  // stable
+  // Cut to one stage: the aspect cascade is cut alike.
+  EXPECT_EQ(firstStages(back, 1).aspectCascades[0].stages.size(), 1u);
+  EXPECT_EQ(firstStages(back, 1).stages.size(), 1u);
+}
+
+TEST(ModelIo, AspectCascadeErrorsNameTheirPlace) {
+  Cascade c = sample();
+  c.aspectCascades.push_back(sideView());
+  const std::string good = modelToText(c);
+  // Claiming an older version: refused (an older build would detect with the first cascade only).
+  EXPECT_NE(errorOf(replace(good, "\"version\": 4", "\"version\": 3"))
+                .find("m.json: aspect_cascades: aspect cascades need format version 4, the file says 3"),
+            std::string::npos);
+  // A broken nested model: the message names the place in the outer file.
+  const std::size_t nested = good.find("\"aspect_cascades\"");
+  std::string bad = good;
+  bad.replace(bad.find("\"threshold\":2.5", nested), 15, "\"threshold\":\"x\"");
+  EXPECT_NE(errorOf(bad).find("m.json: aspect_cascades[0]: stages[0].stumps[0].threshold: expected a number, got string"),
+            std::string::npos)
+      << errorOf(bad);
+  bad = good;
+  bad.replace(bad.find("\"class\": \"car\"", nested), 14, "\"class\": \"bike\"");
+  EXPECT_NE(errorOf(bad).find("aspect cascade 0 is of class 'bike', not 'car'"), std::string::npos) << errorOf(bad);
+  EXPECT_NE(errorOf(replace(good, "\"aspect_cascades\": [", "\"aspect_cascades\": [], \"x\": [")).find(
+                "aspect_cascades: empty"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(good, "\"aspect_cascades\": [", "\"aspect_cascades\": {\"a\": [")).find(
+                "m.json"),
+            std::string::npos);
+  // One level only.
+  Cascade mid = sideView();
+  mid.aspectCascades.push_back(sideView());
+  Cascade deep = sample();
+  deep.aspectCascades.push_back(mid);
+  EXPECT_THROW(deep.validate(), std::invalid_argument);
+  EXPECT_NO_THROW(mid.validate());
+  std::string twoLevels = good;
+  twoLevels.insert(twoLevels.find("\"stages\"", nested), "\"aspect_cascades\": [], ");
+  EXPECT_NE(errorOf(twoLevels).find("m.json: aspect_cascades[0]: an aspect cascade cannot hold aspect cascades"),
+            std::string::npos)
+      << errorOf(twoLevels);
+}
+
+TEST(ModelIo, FuzzedAspectCascadesNeverCrash) {
+  Cascade c = sample();
+  c.aspectCascades.push_back(sideView());
+  const std::string good = modelToText(c);
+  const std::size_t from = good.find("\"aspect_cascades\"");
+  std::mt19937 rng(17);
+  int loaded = 0, rejected = 0;
+  for (int it = 0; it < 2000; ++it) {
+    std::string s = good;
+    const std::size_t p = from + rng() % (good.size() - from);
+    switch (rng() % 3) {
+      case 0: s[p] = "{}[],:\"0-e9.ab4 "[rng() % 16]; break;
+      case 1: s.erase(p, 1 + rng() % 6); break;
+      default: s.insert(p, 1, "{}[],:\"0-e9.ab4 "[rng() % 16]); break;
+    }
+    try {
+      modelFromText(s, "fuzz.json");
+      ++loaded;
+    } catch (const ModelError& e) {
+      EXPECT_NE(std::string(e.what()).find("fuzz.json"), std::string::npos) << e.what();
+      ++rejected;
+    }
+  }
+  EXPECT_GT(rejected, 0);
   EXPECT_EQ(loaded + rejected, 2000);
 }

@@ -57,6 +57,20 @@ struct TrainingConfig {
   // from the samples' cumulative scores of the stages before, and its threshold applies to the
   // cumulative sum. Off by default; in-process training without a validation part only.
   bool softCascade = false;
+  // Side-view cascade (Cascade::aspectCascades): minAspect > 0 = after the cascade (trained
+  // exactly as without this), a second one of the class whose positives are only the labels with
+  // w/h >= minAspect (mirrored and jittered alike), window windowAspect:1 at the same height,
+  // negatives as usual (no window with IoU >= max_negative_iou on any object of the class);
+  // stageMaxFalseAlarm > 0 replaces stage.maxFalseAlarm for it (fewer wide positives make short
+  // stages: a lower rate makes each stage longer), jitterCopies > 0 samples.jitterCopies (more
+  // copies of the few wide positives). A training set without such positives (too few
+  // to train) gives the first cascade alone. Off by default; not with a validation part.
+  struct SideView {
+    double minAspect = 0;
+    double windowAspect = 2.4;
+    double stageMaxFalseAlarm = 0;
+    int jitterCopies = 0;
+  } sideView;
   // The pool's values on every positive are evaluated once per training and kept (pool x
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.
@@ -129,7 +143,8 @@ class NullProgress : public ProgressSink {
   void onProgress(const ProgressEvent&) override {}
 };
 
-// Trains; throws std::invalid_argument for a bad config and std::runtime_error when the data has
+// Trains (with TrainingConfig::sideView: both cascades, `report` of the first); throws
+// std::invalid_argument for a bad config and std::runtime_error when the data has
 // no positives of the class or lacks a selected layer (the message names the item).
 //
 // With `job` (collective.h) training is sharded over its ranks, each calling this with the same
@@ -141,6 +156,10 @@ class NullProgress : public ProgressSink {
 Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem>& train,
                      ProgressSink& progress, TrainingReport* report = nullptr, Collective* job = nullptr);
 
+// `config` without the side view (the first cascade's training), and the side-view cascade's own
+// training config (positives w/h >= sideView.minAspect, window sideView.windowAspect:1).
+TrainingConfig withoutSideView(const TrainingConfig& config);
+TrainingConfig sideViewConfig(const TrainingConfig& config);
 // Reference hue of config.className's positives in `items` (reference_hue.h), from their hue
 // layer. Throws std::runtime_error when no positive has hue values.
 double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples);

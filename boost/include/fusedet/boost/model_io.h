@@ -20,7 +20,8 @@
 //         ...
 //       ]},
 //       ...
-//     ]
+//     ],
+//     "aspect_cascades": [ {a model object as above}, ... ]   (version 4; optional; absent = none)
 //   }
 
 #include <filesystem>
@@ -35,9 +36,11 @@ namespace fusedet::boosting {
 
 // Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
 // standard deviation, feature.h); version 3 adds "cascade": "soft" (cascade.h: cumulative stage
-// sums; an older build refuses the file instead of running it as a hard cascade). Models without
-// them are still written as version 1, byte for byte as before. Every version loads.
-inline constexpr int kModelFormatVersion = 3;
+// sums; an older build refuses the file instead of running it as a hard cascade); version 4 adds
+// "aspect_cascades" (cascade.h: further cascades of the class at their own window aspect, e.g.
+// side views; an older build would detect with the first cascade only). Models without them are
+// still written as version 1, byte for byte as before. Every version loads.
+inline constexpr int kModelFormatVersion = 4;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.
