@@ -336,6 +336,11 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
               cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), cascade.windowWidth,
               cascade.windowHeight, report.seconds);
   std::printf("stop: %s\n", report.stopReason.c_str());
+  for (const boosting::Cascade& a : cascade.aspectCascades)
+    std::printf("side view: window %dx%d, %zu stages, %zu stumps\n", a.windowWidth, a.windowHeight, a.stages.size(),
+                a.weakCount());
+  if (c.sideView.minAspect > 0 && cascade.aspectCascades.empty())
+    std::printf("side view: none trained (too few positives with w/h >= %g)\n", c.sideView.minAspect);
   if (o.eval) evaluateHeldBack(o, cascade, testIds);
   return 0;
 }
