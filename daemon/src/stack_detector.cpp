@@ -1,7 +1,10 @@
 #include "fusedet/daemon/stack_detector.h"
 
+#include <algorithm>
 #include <set>
 #include <stdexcept>
+
+#include <spdlog/spdlog.h>
 
 #include "fusedet/boost/model_io.h"
 
@@ -61,6 +64,20 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("detection.models: ") + e.what());
   }
+  for (const std::string& name : unmatchedClassSettings()) {
+    std::string loaded;
+    for (const std::string& c : classes()) loaded += (loaded.empty() ? "" : ", ") + c;
+    spdlog::warn("detection.classes.{}: no model of class '{}' is loaded ({}); its settings are not used", name, name,
+                 loaded);
+  }
+}
+
+std::vector<std::string> CascadeSet::unmatchedClassSettings() const {
+  const std::vector<std::string> loaded = classes();
+  std::vector<std::string> out;
+  for (const boosting::ClassGrouping& k : perClass_)
+    if (std::find(loaded.begin(), loaded.end(), k.className) == loaded.end()) out.push_back(k.className);
+  return out;
 }
 
 std::vector<Detection> CascadeSet::detect(const LayerStack& stack) const {

@@ -147,6 +147,16 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   for (const char* other : {"person", "bike"}) EXPECT_FALSE(boosting::classDetectionDefault(other).has_value());
 }
 
+// detection.classes entries are matched to the loaded models by class name: the built-in car entry
+// matches the bundled car model; a misspelt or undeployed class is reported, not silently dropped.
+TEST(DetectionSettings, ClassSettingsWithoutAModelAreReported) {
+  Config::Detection d;
+  d.models = {std::string(FUSEDET_SOURCE_DIR) + "/models/car.json", std::string(FUSEDET_SOURCE_DIR) + "/models/bike.json"};
+  EXPECT_TRUE(CascadeSet(d).unmatchedClassSettings().empty());
+  d.classes = {{"car", 16, true}, {"cars", 4, false}, {"person", 5, false}};
+  EXPECT_EQ(CascadeSet(d).unmatchedClassSettings(), (std::vector<std::string>{"cars", "person"}));
+}
+
 // detection.classes: each entry inherits the general min_neighbors / laser_extent it leaves out;
 // given, the list replaces the built-in one ({} = none); unknown keys are named.
 TEST(DetectionSettings, PerClassKeys) {

@@ -42,6 +42,9 @@ class CascadeSet : public StackDetector {
   std::vector<Detection> detect(const LayerStack& stack) const override;
   std::vector<std::string> classes() const override;
   const std::vector<std::filesystem::path>& files() const { return files_; }
+  // detection.classes entries that name no loaded model (a typo, or a class not deployed): they
+  // change nothing, so the constructor logs a warning naming them and the loaded classes.
+  std::vector<std::string> unmatchedClassSettings() const;
 
  private:
   std::unique_ptr<boosting::MultiDetector> detector_;
