@@ -1,6 +1,7 @@
 #include "fusedet/boost/multi_detector.h"
 
 #include "fusedet/boost/aspect_cascades.h"
+#include "fusedet/boost/class_detection.h"
 
 #include "integral_grids.h"
 #include "opencv_pyramid.h"
@@ -59,13 +60,10 @@ std::vector<std::vector<std::vector<RawHit>>> MultiDetector::scanModels(const La
 
 std::vector<Detection> detect(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group) {
-  const std::vector<std::vector<std::vector<RawHit>>> hits = detector.scanModels(stack, scan);
-  std::vector<Detection> out;
-  for (std::size_t i = 0; i < hits.size(); ++i) {
-    std::vector<Detection> d = groupModelHits(detector.cascade(i), hits[i], group, stack);
-    out.insert(out.end(), std::make_move_iterator(d.begin()), std::make_move_iterator(d.end()));
-  }
-  return out;
+  // Every class with the same grouping and no laser extent: detectPerClass() with no class of its own.
+  LaserExtentParams noExtent;
+  noExtent.enabled = false;
+  return detectPerClass(detector, stack, scan, group, noExtent, {});
 }
 
 }  // namespace fusedet::boosting
