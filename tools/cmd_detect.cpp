@@ -12,11 +12,12 @@
 #include <regex>
 
 #include "command.h"
-#include "fusedet/boost/aspect_cascades.h"
+#include "fusedet/boost/class_detection.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"
 #include "fusedet/boost/model_io.h"
+#include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/core/dataset.h"
 #include "fusedet/fusion/box_drawing.h"
@@ -36,8 +37,9 @@ struct DetectOptions {
   fs::path json;
   fs::path draw;
   std::optional<double> scaleFactor;
-  std::optional<int> minNeighbors;
-  bool laserExtent = false;
+  std::optional<int> minNeighbors;  // given: for every class
+  bool laserExtent = false;         // given: on for every class
+  bool classDetection = true;       // a class with settings of its own gets them (class_detection.h)
   std::string minSize, maxSize;
   std::string group = "opencv";
   double iou = 0.5;
@@ -103,8 +105,9 @@ int runDetect(const DetectOptions& o) {
   if (o.image.empty() == o.stack.empty()) throw std::runtime_error("give exactly one of --image and --stack");
   const bool opencv = isOpenCvXml(o.model);
   Cascade cascade = opencv ? loadOpenCvCascade(o.model) : loadModel(o.model);
-  const Detector detector(std::move(cascade));
-  const Cascade& c = detector.cascade();
+  // One model through the path fusedetd runs for all of them (detectPerClass, same decisions).
+  const MultiDetector detector({std::move(cascade)});
+  const Cascade& c = detector.cascade(0);
 
   LayerStack stack;
   cv::Mat bgr;
@@ -132,26 +135,33 @@ int runDetect(const DetectOptions& o) {
   if (!o.minSize.empty()) std::tie(scan.minWidth, scan.minHeight) = parseSize(o.minSize, "--min-size");
   if (!o.maxSize.empty()) std::tie(scan.maxWidth, scan.maxHeight) = parseSize(o.maxSize, "--max-size");
   GroupParams group;
-  group.minNeighbors = o.minNeighbors.value_or(3);
+  group.minNeighbors = o.minNeighbors.value_or(group.minNeighbors);
   group.iouThreshold = o.iou;
   if (o.group == "nms") group.method = GroupParams::Method::kNms;
   else if (o.group != "opencv") throw std::runtime_error("--group must be opencv or nms, not '" + o.group + "'");
-
-  const auto t0 = std::chrono::steady_clock::now();
-  ScanStats stats;
-  // The model's aspect cascades too, merged by the one rule (aspect_cascades.h).
-  const std::vector<std::vector<RawHit>> perCascade = scanModel(detector, stack, scan, &stats);
-  std::vector<Detection> dets = groupModelHits(c, perCascade, group, stack);
-  std::size_t rawHits = 0;
-  for (const auto& h : perCascade) rawHits += h.size();
   LaserExtentParams extent;
   extent.enabled = o.laserExtent;
-  refineToLaserExtent(dets, stack, extent);
+  // The model's class gets its own min neighbours / laser extent (car) unless the option was given.
+  const SetForEveryClass given{false, false, o.minNeighbors.has_value(), o.laserExtent};
+  const std::vector<ClassGrouping> perClass =
+      o.classDetection ? classGroupings(detector, group, extent, given) : std::vector<ClassGrouping>{};
+  const int neighbours = perClass.empty() ? group.minNeighbors : perClass.front().minNeighbors;
+  const bool laserExtent = perClass.empty() ? extent.enabled : perClass.front().laserExtent;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  PerClassWork work;  // the model's aspect cascades too, merged by the one rule (aspect_cascades.h)
+  const std::vector<Detection> dets = detectPerClass(detector, stack, scan, group, extent, perClass, &work);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 
   std::printf("%s on %s (%dx%d): %zu windows at %zu scales, %zu raw hits, %zu detections, %.1f ms\n",
               o.model.filename().string().c_str(), (o.image.empty() ? o.stack : o.image).string().c_str(),
-              stack.width(), stack.height(), stats.windows, stats.scales, rawHits, dets.size(), ms);
+              stack.width(), stack.height(), work.scans[0].windows, work.scans[0].scales, work.rawHits[0], dets.size(),
+              ms);
+  const std::string method = group.method == GroupParams::Method::kNms
+                                 ? "nms (IoU " + std::to_string(group.iouThreshold).substr(0, 4) + ")"
+                                 : "opencv, " + std::to_string(neighbours) + " neighbours";
+  std::printf("  %s grouping: %s, laser extent %s\n", perClass.empty() ? "general" : "class's own", method.c_str(),
+              laserExtent ? "on" : "off");
   for (const Detection& d : dets)
     std::printf("  %s score %.4g  x %.0f y %.0f w %.0f h %.0f\n", d.className.c_str(), d.score, d.box.x, d.box.y,
                 d.box.w, d.box.h);
@@ -202,9 +212,16 @@ const bool registered = registerCommand(
                      "window size step between scales, > 1 (default 1.1, as OpenCV's detectMultiScale)");
       app.add_option("--min-neighbors", o->minNeighbors,
                      "OpenCV grouping: a detection needs more than this many raw hits; 0 = report raw hits "
-                     "ungrouped (default 3, as OpenCV)");
+                     "ungrouped. Default: the class's own (car 16), else 3 as OpenCV; given, it holds for every "
+                     "class, car included");
       app.add_flag("--laser-extent", o->laserExtent,
-                   "after grouping, widen each detection's left and right edges to where its object's cluster in the " "distance layer ends (boost/laser_extent.h; default: off)" " - needs a --stack with a distance layer");
+                   "after grouping, widen each detection's left and right edges to where its object's cluster in the "
+                   "distance layer ends (boost/laser_extent.h) - needs a --stack with a distance layer. Default: the "
+                   "class's own (car on), else off; given, on for every class");
+      app.add_flag("!--no-class-detection", o->classDetection,
+                   "group with the general settings (--min-neighbors or 3, --laser-extent or off) whatever the "
+                   "model's class; by default a class with settings of its own (boost/class_detection.h: car, 16 "
+                   "neighbours and laser extent) gets them for every option not given, as in fusedetd");
       app.add_option("--min-size", o->minSize,
                      "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
                      "smallest training positive, in models that have one - else its base window)");
@@ -230,7 +247,15 @@ const bool registered = registerCommand(
           "      -i /usr/share/doc/opencv-doc/examples/data/messi5.jpg --draw faces.png --json faces.json\n"
           "  fusedet detect -m models/car.json --stack data/kitti_set --item kitti/000042 --group nms\n"
           "  fusedet detect -m eye.xml -i face.png --min-neighbors 0 --min-size 30x30   # raw hits\n"
-          "Prints one line per detection (class, score, box in pixels) after a summary line.");
+          "  fusedet detect -m models/car.json --stack data/kitti_set --no-class-detection   # car as person/bike\n"
+          "Prints a summary line, the grouping used, then one line per detection (class, score, box in pixels).\n\n"
+          "Settings per class: the model's class is grouped as fusedetd groups it (its built-in\n"
+          "detection.classes, boost/class_detection.h): car with 16 neighbours and its boxes widened to the\n"
+          "laser's object (docs/results \"Car at IoU 0.7\"), every other class with 3 neighbours and no\n"
+          "laser extent. --min-neighbors and --laser-extent, when given, hold for every class instead of its\n"
+          "own value; --no-class-detection gives every class the general settings. The scan (scale factor\n"
+          "1.1, step 2) is the same for every class. Car's own settings need the laser: on an --image its\n"
+          "laser extent leaves the boxes unchanged (no distance layer), its 16 neighbours still apply.");
       return [o] { return runDetect(*o); };
     });
 

@@ -579,15 +579,9 @@ int runExperiments(ExperimentOptions o) {
   // A class's own detection settings (class_detection.h) where the preset uses them, unless the
   // command line set that option for every class.
   const bool perClass = preset.classDetection && o.classDetection;
+  const boosting::SetForEveryClass given{o.scaleFactor > 0, o.step > 0, o.minNeighborsGiven, o.laserExtentGiven};
   const auto setupFor = [&](const std::string& cls) {
-    boosting::DetectionSetup s = setup;
-    const std::optional<boosting::ClassDetection> own = perClass ? boosting::classDetectionDefault(cls) : std::nullopt;
-    if (!own) return s;
-    if (o.scaleFactor <= 0) s.scan.scaleFactor = own->scaleFactor;
-    if (o.step <= 0) s.scan.step = own->step;
-    if (!o.minNeighborsGiven) s.group.minNeighbors = own->minNeighbors;
-    if (!o.laserExtentGiven) s.laserExtent.enabled = own->laserExtent;
-    return s;
+    return perClass ? boosting::classDetectionSetup(cls, setup, given) : setup;
   };
   std::string perClassText = "none: every class with the settings above";
   if (perClass)

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "fusedet/boost/class_detection.h"
 #include "fusedet/drivers/usb/usb_match.h"
 #include "fusedet/drivers/v4l2/controls.h"
 
@@ -103,6 +104,13 @@ class Section {
 };
 
 }  // namespace
+
+std::vector<Config::Detection::ClassSettings> Config::Detection::builtInClasses() {
+  std::vector<ClassSettings> out;
+  for (const boosting::ClassGrouping& g : boosting::classGroupings(boosting::classesWithOwnDetection()))
+    out.push_back({g.className, g.minNeighbors, g.laserExtent});
+  return out;
+}
 
 Config parseConfig(const std::string& yamlText, const std::string& source) {
   YAML::Node root;

@@ -135,6 +135,7 @@ TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   // Per class: the built-in list is the library's (car), and the scan fusedet experiments measures
   // car with is the daemon's, so its docs/results figures are what fusedetd does for car.
   const std::vector<boosting::ClassGrouping> perClass = classGroupingFrom(d);
+  ASSERT_EQ(perClass.size(), boosting::classesWithOwnDetection().size());
   ASSERT_EQ(perClass.size(), 1u);
   for (const boosting::ClassGrouping& k : perClass) {
     const std::optional<boosting::ClassDetection> own = boosting::classDetectionDefault(k.className);

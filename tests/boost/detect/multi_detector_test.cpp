@@ -381,6 +381,54 @@ TEST(MultiDetector, DetectPerClassUsesEachClassesOwnGroupingAndLaserExtent) {
   EXPECT_GT(refined, 0u);
 }
 
+// classGroupings() / classDetectionSetup(): the one rule "which settings does a class get" that
+// fusedetd's built-in detection.classes, experiments, demo and detect use. Expected values are
+// classDetectionDefault()'s and the general settings given here.
+TEST(ClassDetection, GroupingsComeFromTheClassDefaultsUnlessSetForEveryClass) {
+  const std::optional<ClassDetection> car = classDetectionDefault("car");
+  ASSERT_TRUE(car.has_value());
+  EXPECT_EQ(classesWithOwnDetection(), std::vector<std::string>{"car"});
+  // Only classes with settings of their own get an entry, each once.
+  const std::vector<ClassGrouping> k = classGroupings({"person", "car", "bike", "car"});
+  ASSERT_EQ(k.size(), 1u);
+  EXPECT_EQ(k[0].className, "car");
+  EXPECT_EQ(k[0].minNeighbors, car->minNeighbors);
+  EXPECT_EQ(k[0].laserExtent, car->laserExtent);
+  EXPECT_TRUE(classGroupings({"person", "bike", "cars"}).empty());
+  // Of a MultiDetector: its models' classes (bundled: car, person, bike).
+  const std::vector<ClassGrouping> m = classGroupings(MultiDetector(bundledModels()));
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_EQ(m[0].minNeighbors, car->minNeighbors);
+  // A setting given for every class replaces car's own; the other stays car's.
+  GroupParams five;
+  five.minNeighbors = 5;
+  LaserExtentParams off;
+  const std::vector<ClassGrouping> g = classGroupings({"car"}, five, off, SetForEveryClass{false, false, true, false});
+  ASSERT_EQ(g.size(), 1u);
+  EXPECT_EQ(g[0].minNeighbors, 5);
+  EXPECT_EQ(g[0].laserExtent, car->laserExtent);
+  const std::vector<ClassGrouping> e = classGroupings({"car"}, five, off, SetForEveryClass{false, false, false, true});
+  EXPECT_EQ(e.at(0).minNeighbors, car->minNeighbors);
+  EXPECT_FALSE(e.at(0).laserExtent);
+  // The full setup of a class scanned on its own (experiments): scan too.
+  DetectionSetup general;
+  general.scan.scaleFactor = 1.2;
+  general.scan.step = 3;
+  general.group.minNeighbors = 4;
+  const DetectionSetup c = classDetectionSetup("car", general);
+  EXPECT_EQ(c.scan.scaleFactor, car->scaleFactor);
+  EXPECT_EQ(c.scan.step, car->step);
+  EXPECT_EQ(c.group.minNeighbors, car->minNeighbors);
+  EXPECT_EQ(c.laserExtent.enabled, car->laserExtent);
+  const DetectionSetup stepGiven = classDetectionSetup("car", general, SetForEveryClass{false, true, false, false});
+  EXPECT_EQ(stepGiven.scan.step, 3);
+  EXPECT_EQ(stepGiven.scan.scaleFactor, car->scaleFactor);
+  const DetectionSetup person = classDetectionSetup("person", general);
+  EXPECT_EQ(person.scan.scaleFactor, 1.2);
+  EXPECT_EQ(person.group.minNeighbors, 4);
+  EXPECT_FALSE(person.laserExtent.enabled);
+}
+
 TEST(MultiDetector, MissingLayerIsNamed) {
   const MultiDetector all(bundledModels());
   LayerStack s = kittiStacks().front();

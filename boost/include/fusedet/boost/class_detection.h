@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"
@@ -32,6 +33,21 @@ struct ClassDetection {
 // The class's own settings, or nullopt when the general ones apply (every class but car).
 std::optional<ClassDetection> classDetectionDefault(const std::string& className);
 
+// Every class that has settings of its own (car), in a fixed order.
+std::vector<std::string> classesWithOwnDetection();
+
+// General settings a command line or config set explicitly "for every class": each one given
+// replaces that setting of every class's own (a class keeps its own for the others).
+struct SetForEveryClass {
+  bool scaleFactor = false, step = false, minNeighbors = false, laserExtent = false;
+};
+
+// The settings `className` is detected with when it is scanned on its own (fusedet experiments):
+// `general`, with the class's own setting (classDetectionDefault) in place of each one not `given`.
+// A class without settings of its own gets `general` unchanged.
+DetectionSetup classDetectionSetup(const std::string& className, const DetectionSetup& general,
+                                   const SetForEveryClass& given = {});
+
 // What follows the shared scan for one class: `group` / `extent` with the class's minimum of
 // neighbours and laser extent (only these two; the method and the rest stay).
 struct ClassGrouping {
@@ -40,11 +56,29 @@ struct ClassGrouping {
   bool laserExtent = LaserExtentParams{}.enabled;
 };
 
+// THE rule "which grouping does a class get" where every class shares one scan (fusedetd's
+// built-in detection.classes, fusedet demo and detect): one entry per class of `classNames` that
+// has settings of its own, in their order, each once; its minNeighbors / laserExtent are those
+// classDetectionSetup() gives (the general value where `given`, else the class's own). Classes
+// without settings of their own get no entry: detectPerClass() groups them with the general ones.
+std::vector<ClassGrouping> classGroupings(const std::vector<std::string>& classNames, const GroupParams& group = {},
+                                          const LaserExtentParams& extent = {}, const SetForEveryClass& given = {});
+// The same for the classes of the detector's models.
+std::vector<ClassGrouping> classGroupings(const MultiDetector& detector, const GroupParams& group = {},
+                                          const LaserExtentParams& extent = {}, const SetForEveryClass& given = {});
+
+// Work done by detectPerClass(), per model (index = model order).
+struct PerClassWork {
+  std::vector<ScanStats> scans;
+  std::vector<std::size_t> rawHits;     // over the model's cascades, aspect cascades included
+  std::vector<std::size_t> detections;  // the output holds model 0's first, then model 1's, ...
+};
+
 // Scan + group for every model as detect(detector, stack, scan, group), then the laser-extent
 // refinement; a model whose class is named in `perClass` is grouped with its minNeighbors and
 // refined only if its laserExtent is set, every other model with `group` and `extent`.
 std::vector<Detection> detectPerClass(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                                       const GroupParams& group, const LaserExtentParams& extent,
-                                      const std::vector<ClassGrouping>& perClass);
+                                      const std::vector<ClassGrouping>& perClass, PerClassWork* work = nullptr);
 
 }  // namespace fusedet::boosting

@@ -87,13 +87,16 @@ struct Config {
     bool laserExtent = false;  // boosting::LaserExtentParams::enabled
     int threads = 0;
     // Per class, its own min_neighbors and laser_extent over the two above (same scan); the
-    // default is boosting::classDetectionDefault()'s (car). A config's `classes:` replaces it.
+    // default is builtInClasses(). A config's `classes:` replaces it.
     struct ClassSettings {
       std::string name;
       int minNeighbors = 3;
       bool laserExtent = false;
     };
-    std::vector<ClassSettings> classes{{"car", 16, true}};
+    // The library's rule: boosting::classGroupings() of every class with settings of its own
+    // (boosting::classesWithOwnDetection(): car), whatever models are loaded.
+    static std::vector<ClassSettings> builtInClasses();
+    std::vector<ClassSettings> classes = builtInClasses();
   } detection;
 
   struct Replay {
