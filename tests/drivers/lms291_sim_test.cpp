@@ -11,8 +11,11 @@
 #include <cmath>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <set>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/lms291/scan_stream.h"
@@ -73,6 +76,7 @@ class LmsSim : public ::testing::Test {
     c.ackTimeout = 300ms;
     return c;
   }
+  std::optional<std::string> lateAnswerRun();
   std::string dir_, link_;
   std::unique_ptr<sim::Simulator> sim_;
 };
@@ -559,18 +563,27 @@ TEST_F(LmsSim, Termios2PathAt500k) {
 // every copy. The next request with the same reply code must get its own reply, not the late
 // answer to a copy of the previous one: variant 100 deg is asked (sent up to three times), then
 // 180 deg, and the second reply must report 180 deg.
-TEST_F(LmsSim, LateAnswersToResentCopiesAreNotTakenForTheNextReply) {
-  sim::SimOptions o;
-  startSim(o);
+//
+// One run of that scenario with a fresh simulator and driver. Returns why the run says nothing
+// (a step met only silence: errc::timed_out), nullopt when it ran to the end; every other error
+// and every wrong reply is a test failure here.
+std::optional<std::string> LmsSim::lateAnswerRun() {
+  const auto silent = [](const char* step, const fusedet::Error& e) -> std::optional<std::string> {
+    if (e.code == std::errc::timed_out) return std::string(step) + ": " + e.message();
+    ADD_FAILURE() << step << ": " << e.message();
+    return std::nullopt;
+  };
+  startSim(sim::SimOptions{});
   Lms291 lms(config(500000, {180, 100}));
   auto started = lms.start();
-  ASSERT_TRUE(started) << started.error().message();
+  if (!started) return silent("start()", started.error());
   RequestOptions ro;
   ro.ackTimeout = 100ms;
   ro.replyTimeout = 1000ms;
   ro.retries = 10;  // copies every ~100 ms: the 250 ms ACK arrives during the third
   const std::uint8_t monitoring[] = {0x25};
-  ASSERT_TRUE(lms.link().request(static_cast<std::uint8_t>(Command::kSwitchMode), monitoring, ro));  // no scans between
+  auto mode = lms.link().request(static_cast<std::uint8_t>(Command::kSwitchMode), monitoring, ro);  // no scans between
+  if (!mode) return silent("monitoring mode", mode.error());
   sim::Faults late;
   late.ackDelay = 250ms;
   sim_->setFaults(late);
@@ -578,10 +591,11 @@ TEST_F(LmsSim, LateAnswersToResentCopiesAreNotTakenForTheNextReply) {
   auto first = lms.link().request(static_cast<std::uint8_t>(Command::kSetVariant), variantPayload({100, 100}), ro);
   auto second = lms.link().request(static_cast<std::uint8_t>(Command::kSetVariant), variantPayload({180, 100}), ro);
   sim_->setFaults({});
-  ASSERT_TRUE(first) << first.error().message();
-  ASSERT_TRUE(second) << second.error().message();
-  ASSERT_EQ(first->data.size(), 5u);
-  ASSERT_EQ(second->data.size(), 5u);
+  if (!first) return silent("first request", first.error());
+  if (!second) return silent("second request", second.error());
+  EXPECT_EQ(first->data.size(), 5u);
+  EXPECT_EQ(second->data.size(), 5u);
+  if (first->data.size() != 5u || second->data.size() != 5u) return std::nullopt;
   EXPECT_EQ(u16(first->data, 1), 100);
   EXPECT_EQ(u16(second->data, 1), 180) << "the second request took a late answer to the first";
   const auto k = lms.counters().link;
@@ -590,8 +604,31 @@ TEST_F(LmsSim, LateAnswersToResentCopiesAreNotTakenForTheNextReply) {
               (unsigned long long)(k.passedOver - before.passedOver), (unsigned long long)sim_->counters().requests);
   EXPECT_LE(k.lateAnswers - before.lateAnswers, k.retries - before.retries);
   auto stopped = lms.stop();
-  EXPECT_TRUE(stopped) << stopped.error().message();
+  if (!stopped) return silent("stop()", stopped.error());
   EXPECT_EQ(sim_->state().baud, 9600);
+  return std::nullopt;
+}
+
+// Under load, the kernel of the shared test machine left the pty's flip-buffer work
+// (flush_to_ldisc) unscheduled for seconds: the driver's and the simulator's threads both sat in
+// poll() in D state (__flush_work from n_tty_poll) and the simulator's trace shows that the host's
+// bytes never reached it (2026-11-30, /work/coord/notes-flaky.md). A run in which a step met only
+// silence says nothing about late answers, so it is run again with a fresh simulator and driver,
+// at most 5 runs within 45 s (the count is printed). A wrong reply, any other error, or a run that
+// ends wrong fails at once; the assertions of a run are those above, unchanged.
+TEST_F(LmsSim, LateAnswersToResentCopiesAreNotTakenForTheNextReply) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::string> silences;
+  for (;;) {
+    const std::optional<std::string> silence = lateAnswerRun();
+    if (HasFailure()) return;
+    if (!silence) break;
+    silences.push_back(*silence);
+    std::printf("run %zu met only silence (%s); again with a fresh simulator\n", silences.size(), silence->c_str());
+    if (silences.size() >= 5 || std::chrono::steady_clock::now() - t0 > 45s)
+      FAIL() << silences.size() << " runs met only silence; the last: " << silences.back();
+  }
+  std::printf("runs: %zu (%zu met only silence)\n", silences.size() + 1, silences.size());
 }
 
 TEST_F(LmsSim, BytesAtTheWrongSpeedAreIgnoredAndScanStampsAccountForLineTime) {
