@@ -30,7 +30,7 @@ std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, co
       if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
     hits = std::move(kept);
   }
-  std::vector<Detection> dets = groupHits(hits, setup.group, first.cascade().className, stack);
+  std::vector<Detection> dets = groupModelHits(first.cascade(), {hits}, setup.group, stack);  // stretches alone
   refineToLaserExtent(dets, stack, setup.laserExtent);
   return dets;
 }

@@ -118,3 +118,44 @@ TEST(AspectCascades, FatesOfADroppedGroupPointToTheDetectionThatReplacedIt) {
   ASSERT_EQ(both.size(), 2u);
   EXPECT_EQ(both[0].box.w, 30);
 }
+
+// Width stretches (ScanParams::widthStretches): one cascade's hits at different window widths are
+// grouped stretch by stretch and merged by the same rule as aspect cascades. The same hits as the
+// test above, the wide ones now stretch 1 of the model's own cascade: the same detections.
+TEST(AspectCascades, WidthStretchesAreGroupedAloneAndMergedByTheSameRule) {
+  const LayerStack stack(300, 100);
+  std::vector<RawHit> hits = around(0, 30, 4);
+  for (RawHit h : around(0, 48, 6)) {
+    h.stretch = 1;
+    hits.push_back(h);
+  }
+  GroupParams g;
+  // (Grouped together, the edge rule would not link them either: right edges 18 px apart, more than
+  // eps x (30 + 20) / 2 = 5.)
+  std::vector<std::vector<HitFate>> fates;
+  const std::vector<Detection> first = groupModelHits(oneStump(30), {hits}, g, stack, &fates);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_EQ(first[0].box.w, 30);  // stretch 0 first (the default order)
+  EXPECT_EQ(first[0].score, 4);
+  ASSERT_EQ(fates.size(), 1u);
+  ASSERT_EQ(fates[0].size(), hits.size());
+  for (const HitFate& f : fates[0]) EXPECT_EQ(f.detection, 0);  // the wide group went to it
+  for (std::size_t i = 4; i < hits.size(); ++i) EXPECT_EQ(fates[0][i].groupSize, 6);
+  g.aspectMerge = kScore;
+  const std::vector<Detection> byScore = groupModelHits(oneStump(30), {hits}, g, stack);
+  ASSERT_EQ(byScore.size(), 1u);
+  EXPECT_EQ(byScore[0].box.w, 48);
+  EXPECT_EQ(byScore[0].score, 6);
+  g.aspectMergeIou = 0.7;  // above their overlap 0.625: both stay, stretch 0's first
+  const std::vector<Detection> both = groupModelHits(oneStump(30), {hits}, g, stack);
+  ASSERT_EQ(both.size(), 2u);
+  EXPECT_EQ(both[0].box.w, 30);
+  EXPECT_EQ(both[1].box.w, 48);
+  // Only stretch 1 hits: a list of its own after an empty stretch 0, as groupHits() of them alone.
+  const std::vector<RawHit> wideOnly(hits.begin() + 4, hits.end());
+  const std::vector<Detection> alone = groupModelHits(oneStump(30), {wideOnly}, GroupParams{}, stack);
+  ASSERT_EQ(alone.size(), 1u);
+  EXPECT_EQ(alone[0].box, groupHits(wideOnly, GroupParams{}, "car", stack)[0].box);
+  hits[0].stretch = -1;
+  EXPECT_THROW(groupModelHits(oneStump(30), {hits}, GroupParams{}, stack), std::invalid_argument);
+}

@@ -59,7 +59,8 @@ std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams
                                  const std::string& className, const LayerStack& stack,
                                  std::vector<HitFate>* fates = nullptr);
 
-// Scan + group in one call.
+// Scan + group in one call: every cascade of the model (aspect cascades) and every width stretch
+// grouped alone and merged by groupModelHits() (aspect_cascades.h).
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group);
 
