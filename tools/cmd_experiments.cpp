@@ -92,6 +92,7 @@ struct ExperimentOptions {
   double aspectMergeIou = 0.5;
   std::string aspectMerge = "first";
   std::vector<double> widthStretches;  // ScanParams::widthStretches on the test frames; empty = none
+  std::string stretchGrouping = "alone";  // alone | together (GroupParams::groupStretchesTogether)
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -330,6 +331,7 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   g.smallHeight = o.smallHeight;
   g.smallMinNeighbors = o.smallMinNeighbors;
   g.aspectMergeIou = o.aspectMergeIou;
+  g.groupStretchesTogether = o.stretchGrouping == "together";
   g.aspectMerge = o.aspectMerge == "first" ? boosting::GroupParams::AspectMerge::kFirstCascadeFirst
                                            : boosting::GroupParams::AspectMerge::kByScore;
   return g;
@@ -348,6 +350,7 @@ std::string widthStretchesText(const ExperimentOptions& o) {
   if (o.widthStretches.empty()) return "none (the model's window aspect only)";
   std::string t;
   for (double v : o.widthStretches) t += (t.empty() ? "" : ", ") + shortNum(v);
+  if (o.stretchGrouping == "together") return t + " x the model's window width, all stretches grouped together";
   return t + " x the model's window width, each grouped alone, merged (" + o.aspectMerge + ") at IoU > " +
          shortNum(o.aspectMergeIou);
 }
@@ -1204,6 +1207,12 @@ const bool registered = registerCommand(
                      "each stretch's hits are grouped alone and merged by --aspect-merge / --aspect-merge-iou, "
                      "listed order first; every class; default: none (the model's aspect only)")
           ->delimiter(',');
+      app.add_option("--stretch-grouping", o->stretchGrouping,
+                     "--width-stretches: 'alone' = each stretch's hits grouped alone, the groups merged by "
+                     "--aspect-merge; 'together' = the hits of every stretch grouped as one list (a group's box "
+                     "is its members' average)")
+          ->check(CLI::IsMember({"alone", "together"}))
+          ->capture_default_str();
       app.add_option("--aspect-merge", o->aspectMerge,
                      "models with aspect cascades or --width-stretches: 'first' = the model's own cascade (the "
                      "first stretch) first, a later one only adds detections where it found none; 'score' = "

@@ -88,11 +88,12 @@ std::vector<Detection> groupModelHits(const Cascade& model, const std::vector<st
       if (h.stretch < 0) throw std::invalid_argument("groupModelHits: a hit with a negative stretch index");
       stretches = std::max(stretches, h.stretch + 1);
     }
-    for (int s = 0; s < stretches; ++s) {
+    const bool together = group.groupStretchesTogether;
+    for (int s = 0; s < (together ? 1 : stretches); ++s) {
       List l{k, {}};
       std::vector<RawHit> own;
       for (std::size_t i = 0; i < hits[k].size(); ++i)
-        if (hits[k][i].stretch == s) {
+        if (together || hits[k][i].stretch == s) {
           l.hit.push_back(i);
           own.push_back(hits[k][i]);
         }

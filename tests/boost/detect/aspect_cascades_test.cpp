@@ -156,6 +156,22 @@ TEST(AspectCascades, WidthStretchesAreGroupedAloneAndMergedByTheSameRule) {
   const std::vector<Detection> alone = groupModelHits(oneStump(30), {wideOnly}, GroupParams{}, stack);
   ASSERT_EQ(alone.size(), 1u);
   EXPECT_EQ(alone[0].box, groupHits(wideOnly, GroupParams{}, "car", stack)[0].box);
+  // Grouped together: exactly groupHits() of all of them: two groups, the 30-px one (4 hits) lies
+  // inside the better supported 48-px one (6) and is dropped by OpenCV's rule.
+  GroupParams together;
+  together.groupStretchesTogether = true;
+  std::vector<std::vector<HitFate>> togetherFates;
+  std::vector<HitFate> wantFates;
+  const std::vector<Detection> joint = groupModelHits(oneStump(30), {hits}, together, stack, &togetherFates);
+  const std::vector<Detection> want = groupHits(hits, together, "car", stack, &wantFates);
+  ASSERT_EQ(joint.size(), 1u);
+  ASSERT_EQ(want.size(), 1u);
+  EXPECT_EQ(joint[0].box, want[0].box);
+  EXPECT_EQ(joint[0].box.w, 48);
+  for (std::size_t i = 0; i < hits.size(); ++i) {
+    EXPECT_EQ(togetherFates[0][i].detection, wantFates[i].detection);
+    EXPECT_EQ(togetherFates[0][i].outcome, i < 4 ? HitFate::Outcome::kInsideBiggerGroup : HitFate::Outcome::kKept);
+  }
   hits[0].stretch = -1;
   EXPECT_THROW(groupModelHits(oneStump(30), {hits}, GroupParams{}, stack), std::invalid_argument);
 }

@@ -38,6 +38,11 @@ struct GroupParams {
   enum class AspectMerge { kByScore, kFirstCascadeFirst };
   AspectMerge aspectMerge = AspectMerge::kFirstCascadeFirst;
   double aspectMergeIou = 0.5;
+  // Width stretches (ScanParams::widthStretches): false = each stretch's hits grouped alone and the
+  // groups merged as aspect cascades (above); true = one cascade's hits of every stretch grouped as
+  // one list (the rule above links windows of different widths only where all four edges lie
+  // close; a group's box is the average of its members, whatever their widths).
+  bool groupStretchesTogether = false;
 };
 
 // What became of one raw hit (miss_analysis.h asks): the detection it went into, or why none.
