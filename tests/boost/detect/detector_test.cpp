@@ -51,6 +51,31 @@ LayerStack randomStack(unsigned seed) {
   return s;
 }
 
+// Every window of the documented geometry (sizes from the 16 x 24 base window by the scale factor,
+// each width stretch in order, step 2 x scale; all rounded half up) on the 120 x 80 test stack,
+// decided the slow way by evaluateWindow(); `windows` counts them.
+std::vector<RawHit> plainScan(const Cascade& c, const IntegralStack& in, const ScanParams& p, std::size_t& windows) {
+  std::vector<RawHit> expect;
+  windows = 0;
+  int scale = 0;
+  const std::vector<double> stretches = widthStretchesOf(p);
+  for (std::size_t k = 0; k < stretches.size(); ++k)
+    for (double f = 1;; f *= p.scaleFactor) {
+      const int w = int(std::floor(16 * stretches[k] * f + 0.5)), h = int(std::floor(24 * f + 0.5));
+      if (w > 120 || h > 80) break;
+      const int step = std::max(1, int(std::floor(2 * f + 0.5)));
+      for (int y = 0; y + h <= 80; y += step)
+        for (int x = 0; x + w <= 120; x += step) {
+          ++windows;
+          const Box box{double(x), double(y), double(w), double(h)};
+          const WindowResult r = evaluateWindow(c, in, box);
+          if (r.accepted) expect.push_back(RawHit{box, r.score, scale, static_cast<int>(k)});
+        }
+      ++scale;
+    }
+  return expect;
+}
+
 }  // namespace
 
 TEST(Detector, ScanAgreesWithPerWindowEvaluationOnEveryWindow) {
@@ -63,20 +88,8 @@ TEST(Detector, ScanAgreesWithPerWindowEvaluationOnEveryWindow) {
   ScanStats stats;
   const Detector det(c);
   const std::vector<RawHit> hits = det.scan(s, p, &stats);
-  // Recompute every window the slow way with the documented geometry.
-  std::vector<RawHit> expect;
   std::size_t windows = 0;
-  for (double f = 1;; f *= p.scaleFactor) {
-    const int w = int(std::floor(16 * f + 0.5)), h = int(std::floor(24 * f + 0.5));
-    if (w > 120 || h > 80) break;
-    const int step = std::max(1, int(std::floor(2 * f + 0.5)));
-    for (int y = 0; y + h <= 80; y += step)
-      for (int x = 0; x + w <= 120; x += step) {
-        ++windows;
-        const WindowResult r = evaluateWindow(c, in, Box{double(x), double(y), double(w), double(h)});
-        if (r.accepted) expect.push_back(RawHit{Box{double(x), double(y), double(w), double(h)}, r.score, 0});
-      }
-  }
+  const std::vector<RawHit> expect = plainScan(c, in, p, windows);
   EXPECT_EQ(stats.windows, windows);
   ASSERT_EQ(hits.size(), expect.size());
   ASSERT_GT(hits.size(), 10u) << "the test cascade should accept some windows";
@@ -94,27 +107,9 @@ TEST(Detector, StretchedWindowsAgreeWithPerWindowEvaluationInBothScanners) {
   const Cascade c = randomCascade(1);
   const LayerStack s = randomStack(2);
   const IntegralStack in = integrateFor(c, s);
-  ScanParams p;
-  p.scaleFactor = 1.25;
-  p.threads = 1;
-  p.widthStretches = {1.0, 1.3, 1.6};
-  std::vector<RawHit> expect;
+  ScanParams p{.scaleFactor = 1.25, .threads = 1, .widthStretches = {1.0, 1.3, 1.6}};
   std::size_t windows = 0;
-  int scale = 0;
-  for (std::size_t k = 0; k < p.widthStretches.size(); ++k)
-    for (double f = 1;; f *= p.scaleFactor) {
-      const int w = int(std::floor(16 * p.widthStretches[k] * f + 0.5)), h = int(std::floor(24 * f + 0.5));
-      if (w > 120 || h > 80) break;
-      const int step = std::max(1, int(std::floor(2 * f + 0.5)));
-      for (int y = 0; y + h <= 80; y += step)
-        for (int x = 0; x + w <= 120; x += step) {
-          ++windows;
-          const Box box{double(x), double(y), double(w), double(h)};
-          const WindowResult r = evaluateWindow(c, in, box);
-          if (r.accepted) expect.push_back(RawHit{box, r.score, scale, static_cast<int>(k)});
-        }
-      ++scale;
-    }
+  const std::vector<RawHit> expect = plainScan(c, in, p, windows);
   const Detector det(c);
   std::size_t stretched = 0;
   for (const RawHit& h : expect) stretched += h.stretch > 0;
