@@ -589,7 +589,7 @@ int runExperiments(ExperimentOptions o) {
   setup.group = groupParams(o);
   setup.laserExtent.enabled = o.laserExtent;
   setup.scan.widthStretches = o.widthStretches;
-  boosting::widthStretchesOf(setup.scan);  // throws on a bad list before any work is done
+  boosting::widthStretchesOf(setup.scan);  // a bad list is refused before any training or detection
   // A class's own detection settings (class_detection.h) where the preset uses them, unless the
   // command line set that option for every class.
   const bool perClass = preset.classDetection && o.classDetection;
