@@ -84,6 +84,9 @@ struct ExperimentOptions {
   double nmsIou = 0.5;
   int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
+  bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
+  double boxFitLambda = boosting::BoxFitParams{}.lambda;
+  double boxFitMinIou = boosting::BoxFitParams{}.minIou;
   // Per-class detection settings (boost/class_detection.h, car) where the preset uses them; an
   // option given on the command line applies to every class instead.
   bool classDetection = true;
@@ -437,6 +440,12 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
     spec.parts = {trainingConfig(o, p, cls, trainedConfig(config), match)};
   }
   spec.keepStages = keptStages(o, cls);
+  if (o.boxFit) {
+    boosting::BoxFitParams fit;
+    fit.lambda = o.boxFitLambda;
+    fit.minIou = o.boxFitMinIou;
+    spec.boxFit = fit;
+  }
   return spec;
 }
 
@@ -640,6 +649,10 @@ int runExperiments(ExperimentOptions o) {
       {"per-class detection (boost/class_detection.h; --no-class-detection: none)", perClassText},
       {"laser-extent box refinement (--laser-extent)",
        o.laserExtent ? "on: left/right edges widened to the distance layer's object cluster" : "off"},
+      {"learned box refinement (--box-fit)",
+       o.boxFit ? "on: per fold fitted on its training frames' detections matched at IoU >= " + shortNum(o.boxFitMinIou) +
+                      ", ridge lambda " + shortNum(o.boxFitLambda) + " (boost/box_regression.h)"
+                : "off"},
       {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
@@ -1194,6 +1207,18 @@ const bool registered = registerCommand(
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "
                    "cluster in the distance layer ends (boost/laser_extent.h; default: off, but car's own setting "
                    "where the preset uses per-class detection); given, it applies to every class");
+      app.add_flag("--box-fit", o->boxFit,
+                   "learned box refinement (boost/box_regression.h): per fold, fit a ridge regression of the "
+                   "matched labels' boxes on each detection's group, member and laser features over the fold's "
+                   "TRAINING frames with its cascades, and apply it to its held-out frames (every class; a class "
+                   "with too few matched detections keeps its boxes). Default: off");
+      app.add_option("--box-fit-lambda", o->boxFitLambda, "--box-fit: ridge penalty on standardised features (> 0)")
+          ->check(CLI::PositiveNumber)
+          ->capture_default_str();
+      app.add_option("--box-fit-min-iou", o->boxFitMinIou,
+                     "--box-fit: a training detection is a sample when it overlaps its best positive label by this IoU")
+          ->check(CLI::Range(0.05, 1.0))
+          ->capture_default_str();
       app.add_flag("!--no-class-detection", o->classDetection,
                    "detect every class with the general settings (--scale-factor, --step, --min-neighbors, "
                    "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "

@@ -9,30 +9,98 @@
 
 namespace fusedet::boosting {
 
-std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
-                                   const DetectionSetup& setup, ScanStats* stats) {
+void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vector<RawHit>>& hits,
+                 const std::vector<std::vector<HitFate>>& fates, const LayerStack& stack,
+                 const LaserExtentParams& extent, const BoxRegression& regression, std::vector<GroupedBox>* groups) {
+  if (!regression.fitted() && !groups) {
+    refineToLaserExtent(detections, stack, extent);
+    return;
+  }
+  std::vector<GroupedBox> g(detections.size());
+  for (std::size_t i = 0; i < detections.size(); ++i) g[i].groupBox = detections[i].box;
+  for (std::size_t k = 0; k < hits.size() && k < fates.size(); ++k)
+    for (std::size_t i = 0; i < hits[k].size() && i < fates[k].size(); ++i) {
+      const HitFate& f = fates[k][i];
+      // Members only: a hit suppressed by NMS is not.
+      if (f.outcome == HitFate::Outcome::kKept && f.detection >= 0 && static_cast<std::size_t>(f.detection) < g.size())
+        g[static_cast<std::size_t>(f.detection)].members.push_back(hits[k][i].box);
+    }
+  refineToLaserExtent(detections, stack, extent);
+  for (std::size_t i = 0; i < detections.size(); ++i) {
+    g[i].box = detections[i].box;
+    if (regression.fitted()) {
+      detections[i].box = regression.refine(g[i], stack);
+      detections[i].unitBox = stack.toUnit(detections[i].box);
+    }
+  }
+  if (groups) *groups = std::move(g);
+}
+
+std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& chain, const LayerStack& stack,
+                                         const DetectionSetup& setup, std::vector<GroupedBox>& groups,
+                                         ScanStats* stats) {
   if (chain.empty()) throw std::invalid_argument("detectChain: no cascade given");
   const Detector& first = *chain.front();
+  std::vector<std::vector<RawHit>> hits;
+  std::vector<std::vector<HitFate>> fates;
+  std::vector<Detection> dets;
   if (!first.cascade().aspectCascades.empty()) {
     if (chain.size() > 1) throw std::invalid_argument(first.cascade().source + ": a model with aspect cascades cannot be AND-combined");
-    std::vector<Detection> dets =
-        groupModelHits(first.cascade(), scanModel(first, stack, setup.scan, stats), setup.group, stack);
-    refineToLaserExtent(dets, stack, setup.laserExtent);
-    return dets;
+    hits = scanModel(first, stack, setup.scan, stats);
+    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);
+  } else {
+    hits.push_back(first.scan(stack, setup.scan, stats));
+    for (std::size_t k = 1; k < chain.size() && !hits[0].empty(); ++k) {
+      const Cascade& c = chain[k]->cascade();
+      if (c.isOpenCv()) throw std::invalid_argument(c.source + ": an OpenCV cascade cannot be AND-combined");
+      const IntegralStack integrals = integrateFor(c, stack);
+      std::vector<RawHit> kept;
+      for (const RawHit& h : hits[0])
+        if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
+      hits[0] = std::move(kept);
+    }
+    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);  // stretches alone
   }
-  std::vector<RawHit> hits = first.scan(stack, setup.scan, stats);
-  for (std::size_t k = 1; k < chain.size() && !hits.empty(); ++k) {
-    const Cascade& c = chain[k]->cascade();
-    if (c.isOpenCv()) throw std::invalid_argument(c.source + ": an OpenCV cascade cannot be AND-combined");
-    const IntegralStack integrals = integrateFor(c, stack);
-    std::vector<RawHit> kept;
-    for (const RawHit& h : hits)
-      if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
-    hits = std::move(kept);
-  }
-  std::vector<Detection> dets = groupModelHits(first.cascade(), {hits}, setup.group, stack);  // stretches alone
-  refineToLaserExtent(dets, stack, setup.laserExtent);
+  refineBoxes(dets, hits, fates, stack, setup.laserExtent, BoxRegression{}, &groups);
   return dets;
+}
+
+std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
+                                   const DetectionSetup& setup, ScanStats* stats) {
+  std::vector<GroupedBox> groups;
+  std::vector<Detection> dets = detectChainGroups(chain, stack, setup, groups, stats);
+  if (setup.boxRegression.fitted())
+    for (std::size_t i = 0; i < dets.size(); ++i) {
+      dets[i].box = setup.boxRegression.refine(groups[i], stack);
+      dets[i].unitBox = stack.toUnit(dets[i].box);
+    }
+  return dets;
+}
+
+BoxRegression fitBoxRefinement(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
+                               const std::vector<std::size_t>& indices, const MatchConfig& match,
+                               const DetectionSetup& setup, const BoxFitParams& params) {
+  std::vector<std::vector<double>> features;
+  std::vector<BoxTargets> targets;
+  for (std::size_t i : indices) {
+    const DatasetItem& item = items.at(i);
+    std::vector<GroupedBox> groups;
+    const std::vector<Detection> dets = detectChainGroups(chain, item.stack, setup, groups);
+    const StackMatch m = matchDetections(dets, item.labels, match);  // the label roles (moderate, class)
+    for (std::size_t d = 0; d < dets.size(); ++d) {
+      double best = 0;
+      const Label* truth = nullptr;
+      for (std::size_t l = 0; l < item.labels.size(); ++l) {
+        if (m.labelRoles[l] != LabelRole::kPositive) continue;
+        const double o = iou(dets[d].box, item.labels[l].box);
+        if (o > best) best = o, truth = &item.labels[l];
+      }
+      if (!truth || best < params.minIou || !(dets[d].box.w > 0) || !(dets[d].box.h > 0)) continue;
+      features.push_back(boxFeatures(groups[d], item.stack));
+      targets.push_back(boxTargets(dets[d].box, truth->box));
+    }
+  }
+  return fitBoxRegression(features, targets, params);
 }
 
 EvalOutcome evaluateChain(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,

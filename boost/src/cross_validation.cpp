@@ -187,11 +187,21 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     }
     std::vector<const Detector*> chain;
     for (const Detector& d : detectors) chain.push_back(&d);
-    const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, setup);
+    DetectionSetup foldSetup = setup;
+    if (spec.boxFit) {
+      foldSetup.boxRegression = fitBoxRefinement(chain, testItems, fold.train, match, setup, *spec.boxFit);
+      out.boxFits.push_back(foldSetup.boxRegression);
+      if (log)
+        log("fold " + shortName + ": box refinement " +
+            (foldSetup.boxRegression.fitted() ? "fitted on " + std::to_string(foldSetup.boxRegression.samples) +
+                                                    " training detections"
+                                              : "not fitted (" + foldSetup.boxRegression.why + ")"));
+    }
+    const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, foldSetup);
     for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
     // The analysis detects on its own; it must see exactly what the evaluation saw.
     const auto explain = [&](const DatasetItem& item, const StackMatch& evaluated) {
-      FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, setup);
+      FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, foldSetup);
       if (a.match.hits != evaluated.hits || a.match.falseAlarms != evaluated.falseAlarms)
         throw std::logic_error("crossValidate: the miss analysis detected differently from the evaluation on " + item.id);
       return std::move(a.positives);
@@ -204,7 +214,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     detected += fold.test.size();
     std::size_t trainHits = 0, trainFalseAlarms = 0, trainPositives = 0;
     if (spec.scoreTrainingItems) {
-      const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, setup);
+      const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, foldSetup);
       out.trainingFrames.insert(out.trainingFrames.end(), own.frames.begin(), own.frames.end());
       if (spec.analyseMisses)
         for (std::size_t k = 0; k < fold.train.size(); ++k)

@@ -104,7 +104,7 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
   const std::vector<std::vector<RawHit>> hits = scanModel(detector, stack, setup.scan);
   std::vector<std::vector<HitFate>> fates;
   out.detections = groupModelHits(cascade, hits, setup.group, stack, &fates);
-  refineToLaserExtent(out.detections, stack, setup.laserExtent);  // as detectChain(): boxes only, same order
+  refineBoxes(out.detections, hits, fates, stack, setup.laserExtent, setup.boxRegression);  // as detectChain(): boxes only, same order
   out.match = matchDetections(out.detections, labels, match);
 
   std::vector<std::map<std::tuple<double, double, double, double>, std::size_t>> hitAt(cascades.size());  // window -> raw hit

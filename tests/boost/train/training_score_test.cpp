@@ -65,6 +65,21 @@ DetectionSetup fineSetup() {
   return setup;
 }
 
+// The folds' training configuration: the small synthetic cascade on one thread.
+TrainingConfig oneThreadConfig() {
+  TrainingConfig config = synthetic::smallConfig();
+  config.threads = 1;
+  return config;
+}
+
+// The cascade a fold trains, trained here on the same items.
+Detector trainedLike(const std::vector<DatasetItem>& items, const Fold& fold, const TrainingConfig& config) {
+  std::vector<DatasetItem> train;
+  for (std::size_t i : fold.train) train.push_back(items[i]);
+  NullProgress quiet;
+  return Detector(trainCascade(config, train, quiet));
+}
+
 std::vector<Fold> foldsOf(const std::vector<DatasetItem>& items) {
   std::vector<std::string> groups;
   for (const auto& it : items) groups.push_back(it.group);
@@ -77,8 +92,7 @@ TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
   ASSERT_EQ(folds.size(), 2u);
   const MatchConfig match = carMatch();
   const DetectionSetup setup = fineSetup();
-  TrainingConfig config = synthetic::smallConfig();
-  config.threads = 1;
+  const TrainingConfig config = oneThreadConfig();
   ChainSpec spec{{config}};
   NullProgress quiet;
   const CrossValidationResult plain = crossValidate(spec, items, items, folds, match, setup, {}, quiet);
@@ -101,9 +115,7 @@ TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
     EXPECT_EQ(scored.trainingFrames[k].positives, 0u);
   }
   // Fold 1: the same cascade trained here, run on the same training items, matched by hand.
-  std::vector<DatasetItem> train;
-  for (std::size_t i : folds[0].train) train.push_back(items[i]);
-  const Detector det(trainCascade(config, train, quiet));
+  const Detector det = trainedLike(items, folds[0], config);
   Tally expected;  // summed over the fold's training items
   std::size_t hits = 0, falseAlarms = 0, positives = 0;
   for (std::size_t k = 0; k < folds[0].train.size(); ++k) {
@@ -135,8 +147,7 @@ TEST(TrainingScore, MissAnalysisOfTheOwnTrainingItems) {
   std::swap(folds[0], folds[1]);  // the untrainable fold first: its outcomes must come first too
   const MatchConfig match = carMatch();
   const DetectionSetup setup = fineSetup();
-  TrainingConfig config = synthetic::smallConfig();
-  config.threads = 1;
+  const TrainingConfig config = oneThreadConfig();
   ChainSpec spec{{config}};
   spec.analyseMisses = true;
   NullProgress quiet;
@@ -150,9 +161,7 @@ TEST(TrainingScore, MissAnalysisOfTheOwnTrainingItems) {
   for (std::size_t k = 0; k < 2; ++k) EXPECT_TRUE(r.trainingPositives[k].empty()) << k;
   // The fold that trains on "full": the analysis of a cascade trained here on the same items,
   // called directly, and the training score's hits, item by item.
-  std::vector<DatasetItem> train;
-  for (std::size_t i : folds[1].train) train.push_back(items[i]);
-  const Detector det(trainCascade(config, train, quiet));
+  const Detector det = trainedLike(items, folds[1], config);
   std::size_t explained = 0, missed = 0;
   for (std::size_t k = 0; k < folds[1].train.size(); ++k) {
     const DatasetItem& item = items[folds[1].train[k]];
@@ -179,6 +188,44 @@ TEST(TrainingScore, MissAnalysisOfTheOwnTrainingItems) {
   EXPECT_EQ(b.allMisses, missed);
   EXPECT_EQ(b.total[static_cast<std::size_t>(MissCause::kUntrained)], 0u);
   EXPECT_GE(missed, 1u);  // 14 of 20 when written (the small cascade's boxes miss IoU 0.5 often)
+}
+
+// ChainSpec::boxFit: each trained fold fits the learned box refinement on ITS OWN training items
+// with its own cascade (the same fit as fitBoxRefinement() with a cascade trained here on those
+// items), an untrained fold fits nothing, and the scored training items are detected with it.
+TEST(TrainingScore, BoxRefinementFittedPerFoldOnItsTrainingItems) {
+  const std::vector<DatasetItem> items = twoDrives();
+  const std::vector<Fold> folds = foldsOf(items);  // fold 0 trains on "full", fold 1 on "empty"
+  ASSERT_EQ(folds.size(), 2u);
+  const MatchConfig match = carMatch();
+  const DetectionSetup setup = fineSetup();
+  const TrainingConfig config = oneThreadConfig();
+  ChainSpec spec{{config}};
+  spec.scoreTrainingItems = true;
+  BoxFitParams fit;
+  fit.minSamples = 3;
+  fit.minIou = 0.2;
+  spec.boxFit = fit;
+  NullProgress quiet;
+  const CrossValidationResult r = crossValidate(spec, items, items, folds, match, setup, {}, quiet);
+  ASSERT_EQ(r.boxFits.size(), 1u);  // the untrainable fold has none
+  const Detector det = trainedLike(items, folds[0], config);
+  const BoxRegression want = fitBoxRefinement({&det}, items, folds[0].train, match, setup, fit);
+  ASSERT_TRUE(want.fitted()) << want.why;  // 20 cars, the small cascade finds enough at IoU 0.2
+  EXPECT_EQ(r.boxFits[0].samples, want.samples);
+  ASSERT_EQ(r.boxFits[0].weights.size(), want.weights.size());
+  for (std::size_t j = 0; j < want.weights.size(); ++j)
+    for (std::size_t k = 0; k < 4; ++k) EXPECT_DOUBLE_EQ(r.boxFits[0].weights[j][k], want.weights[j][k]);
+  // The training score of fold 0 is the refined detection's: hits counted by hand on refined boxes.
+  DetectionSetup refined = setup;
+  refined.boxRegression = want;
+  for (std::size_t k = 0; k < folds[0].train.size(); ++k) {
+    const Tally t = tally(det, items[folds[0].train[k]], refined);
+    std::size_t h = 0;
+    for (const auto& d : r.trainingFrames[k].detections) h += d.hit ? 1 : 0;
+    EXPECT_EQ(h, t.hits) << k;
+    EXPECT_EQ(r.trainingFrames[k].detections.size() - h, t.falseAlarms) << k;
+  }
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "fusedet/boost/box_regression.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/grouping.h"
@@ -20,6 +21,7 @@ struct DetectionSetup {
   ScanParams scan;
   GroupParams group;
   LaserExtentParams laserExtent;  // box refinement after grouping (off by default)
+  BoxRegression boxRegression{};  // learned refinement after the laser extent (none by default)
 };
 
 struct EvalOutcome {
@@ -34,6 +36,29 @@ struct EvalOutcome {
 // Detections of a chain of detectors (AND) on one stack; adds the scan's work to `stats`.
 std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                    const DetectionSetup& setup, ScanStats* stats = nullptr);
+
+// What follows grouping, the one rule detectChain(), the miss analysis and detectPerClass() share:
+// the laser extent (laser_extent.h), then `regression` (identity when not fitted) on grouped
+// detections. hits[k] / fates[k]: cascade k's raw hits and what became of them (grouping.h,
+// aspect_cascades.h; a fate's `detection` indexes `detections`). `groups` (optional) gets each
+// detection's GroupedBox (its box before `regression`).
+void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vector<RawHit>>& hits,
+                 const std::vector<std::vector<HitFate>>& fates, const LayerStack& stack,
+                 const LaserExtentParams& extent, const BoxRegression& regression,
+                 std::vector<GroupedBox>* groups = nullptr);
+
+// Detections of the chain before `setup.boxRegression`, each with what formed it (box_regression.h).
+std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& chain, const LayerStack& stack,
+                                         const DetectionSetup& setup, std::vector<GroupedBox>& groups,
+                                         ScanStats* stats = nullptr);
+
+// Fits the learned box refinement on items[indices] (a fold's TRAINING frames): each detection of
+// the chain (setup without its boxRegression) whose best-overlapping positive label (match's
+// rules) overlaps it by IoU >= params.minIou is a sample, its targets that label's box (the
+// result's `samples` says how many were used).
+BoxRegression fitBoxRefinement(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
+                               const std::vector<std::size_t>& indices, const MatchConfig& match,
+                               const DetectionSetup& setup, const BoxFitParams& params);
 
 // Runs the chain on every item and matches against its labels.
 EvalOutcome evaluateChain(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,

@@ -71,6 +71,8 @@ struct CrossValidationResult {
   // With both analyseMisses and scoreTrainingItems: the same per (fold, training item), in the
   // order of trainingFrames - where a cascade loses the objects it was trained on.
   std::vector<std::vector<PositiveOutcome>> trainingPositives;
+  // With ChainSpec::boxFit: per trained fold, the refinement fitted on its training items.
+  std::vector<BoxRegression> boxFits;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -86,6 +88,10 @@ struct ChainSpec {
   // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives
   // (and, with scoreTrainingItems, into trainingPositives); needs a chain of one cascade.
   bool analyseMisses = false;
+  // Fit the learned box refinement (box_regression.h) per fold on the fold's own training items
+  // with the fold's cascades, apply it on its held-out items (and its training items when they are
+  // scored): no held-out frame informs its own boxes. Unset = the setup's (none by default).
+  std::optional<BoxFitParams> boxFit{};
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
