@@ -49,7 +49,7 @@ struct GroupedBox {
   std::vector<Box> members;  // empty: NMS's single hit, or no member information (the box itself)
 };
 
-// The feature vector above (featureCount() entries, all finite).
+// The feature vector above (boxFeatureCount() entries, all finite).
 std::vector<double> boxFeatures(const GroupedBox& g, const LayerStack& stack);
 std::size_t boxFeatureCount();
 

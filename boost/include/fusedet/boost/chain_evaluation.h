@@ -37,7 +37,8 @@ struct EvalOutcome {
 std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                    const DetectionSetup& setup, ScanStats* stats = nullptr);
 
-// What follows grouping, the one rule detectChain(), the miss analysis and detectPerClass() share:
+// What follows grouping, the one rule detectChain() and the miss analysis share (detectPerClass(),
+// what fusedetd runs, applies the laser extent only: no model holds a fit, box_regression.h):
 // the laser extent (laser_extent.h), then `regression` (identity when not fitted) on grouped
 // detections. hits[k] / fates[k]: cascade k's raw hits and what became of them (grouping.h,
 // aspect_cascades.h; a fate's `detection` indexes `detections`). `groups` (optional) gets each
