@@ -36,9 +36,13 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
   if (groups) *groups = std::move(g);
 }
 
-std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& chain, const LayerStack& stack,
-                                         const DetectionSetup& setup, std::vector<GroupedBox>& groups,
-                                         ScanStats* stats) {
+namespace {
+
+// Scan, AND chain, group, then refineBoxes() with setup.boxRegression; `groups` (optional) gets
+// what formed each detection.
+std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain, const LayerStack& stack,
+                                       const DetectionSetup& setup, std::vector<GroupedBox>* groups,
+                                       ScanStats* stats) {
   if (chain.empty()) throw std::invalid_argument("detectChain: no cascade given");
   const Detector& first = *chain.front();
   std::vector<std::vector<RawHit>> hits;
@@ -61,20 +65,23 @@ std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& cha
     }
     dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);  // stretches alone
   }
-  refineBoxes(dets, hits, fates, stack, setup.laserExtent, BoxRegression{}, &groups);
+  refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);
   return dets;
+}
+
+}  // namespace
+
+std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& chain, const LayerStack& stack,
+                                         const DetectionSetup& setup, std::vector<GroupedBox>& groups,
+                                         ScanStats* stats) {
+  DetectionSetup unrefined = setup;
+  unrefined.boxRegression = {};
+  return detectAndRefine(chain, stack, unrefined, &groups, stats);
 }
 
 std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                    const DetectionSetup& setup, ScanStats* stats) {
-  std::vector<GroupedBox> groups;
-  std::vector<Detection> dets = detectChainGroups(chain, stack, setup, groups, stats);
-  if (setup.boxRegression.fitted())
-    for (std::size_t i = 0; i < dets.size(); ++i) {
-      dets[i].box = setup.boxRegression.refine(groups[i], stack);
-      dets[i].unitBox = stack.toUnit(dets[i].box);
-    }
-  return dets;
+  return detectAndRefine(chain, stack, setup, nullptr, stats);
 }
 
 BoxRegression fitBoxRefinement(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
