@@ -109,6 +109,129 @@ TEST(Grouping, SmallGroupsMayNeedFewerNeighbours) {
   EXPECT_TRUE(groupHits(hits, p, "car", stack).empty());
 }
 
+namespace {
+
+// 400 x 200 reference pixels with a distance layer of the same size: `left` m in columns 0..99,
+// `right` m from column 100 (two cars side by side, or a car before a wall).
+LayerStack twoDepths(float left, float right) {
+  LayerStack s(400, 200);
+  cv::Mat1f d(200, 400, right);
+  d(cv::Rect(0, 0, 100, 200)).setTo(left);
+  s.set(Layer{std::string(layer::kDistance), d, {}});
+  return s;
+}
+
+// A chain of 60 x 40 windows at y 50 from x 20 to x 142, each within the edge rule's reach (eps 0.2
+// x (60 + 40) / 2 = 10 px) of the next: one group by cv::groupRectangles' rule. A window's core
+// (laser_cells.h) is columns x + 15 .. x + 45, so its median depth is the left one while most of
+// those lie left of column 100 (x <= 60) and the right one from x 70.
+std::vector<RawHit> chainAcrossTwoDepths() {
+  std::vector<RawHit> hits;
+  for (int x : {20, 24, 28, 32, 40, 50, 60, 70, 80, 90, 100, 110, 120, 130, 134, 138, 142})
+    hits.push_back(RawHit{Box{double(x), 50, 60, 40}, 1, 0});
+  return hits;
+}
+
+GroupParams depthLinked(double relative, double metres) {
+  GroupParams p;
+  p.minNeighbors = 3;
+  p.depthLink = true;
+  p.depthRelative = relative;
+  p.depthMetres = metres;
+  return p;
+}
+
+}  // namespace
+
+// Two adjacent objects at 10 m and 20 m: the edge rule chains all 17 windows into one box at x
+// round(1368 / 17) = 80 that lies between them; linked by depth they stay two groups, x 20..60
+// (7 windows, mean 254 / 7 = 36.3 -> 36) and x 70..142 (10 windows, mean 111.4 -> 111).
+TEST(Grouping, DepthLinkKeepsWindowsAtDifferentDepthsApart) {
+  const LayerStack stack = twoDepths(10, 20);
+  const std::vector<RawHit> hits = chainAcrossTwoDepths();
+  const auto old = groupHits(hits, GroupParams{}, "car", stack);
+  ASSERT_EQ(old.size(), 1u);
+  EXPECT_EQ(old[0].box, (Box{80, 50, 60, 40}));
+  EXPECT_EQ(old[0].score, 17);
+  std::vector<HitFate> fates;
+  const auto d = groupHits(hits, depthLinked(0.1, 0), "car", stack, &fates);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0].box, (Box{36, 50, 60, 40}));
+  EXPECT_EQ(d[0].score, 7);
+  EXPECT_EQ(d[1].box, (Box{111, 50, 60, 40}));
+  EXPECT_EQ(d[1].score, 10);
+  EXPECT_EQ(fates[6].detection, 0);  // x 60: core columns 75..105, 25 of 31 at 10 m
+  EXPECT_EQ(fates[7].detection, 1);  // x 70: 15 of 31 at 10 m, so the median is 20 m
+  // The tolerance decides: 10 m apart is within 100 % of 10 m, or 10 m; not within 9.9 m.
+  EXPECT_EQ(groupHits(hits, depthLinked(1.0, 0), "car", stack).size(), 1u);
+  EXPECT_EQ(groupHits(hits, depthLinked(0, 10), "car", stack).size(), 1u);
+  EXPECT_EQ(groupHits(hits, depthLinked(0, 9.9), "car", stack).size(), 2u);
+  EXPECT_EQ(groupHits(hits, depthLinked(0.5, 4.9), "car", stack).size(), 2u);  // 5 + 4.9 < 10
+}
+
+// Same depth everywhere, no distance layer, or no valid laser cell: the edge rule alone.
+TEST(Grouping, DepthLinkWithoutDepthDifferenceOrLaserIsTheEdgeRule) {
+  const std::vector<RawHit> hits = chainAcrossTwoDepths();
+  const auto expected = groupHits(hits, GroupParams{}, "car", twoDepths(10, 20));
+  LayerStack noMask = twoDepths(0, 0);  // 0 m = not measured
+  LayerStack masked = twoDepths(10, 20);
+  masked.find(layer::kDistance)->valid = cv::Mat::zeros(200, 400, CV_8U);
+  for (const LayerStack& stack : {twoDepths(15, 15), LayerStack(400, 200), noMask, masked}) {
+    const auto d = groupHits(hits, depthLinked(0.1, 0), "car", stack);
+    ASSERT_EQ(d.size(), expected.size());
+    EXPECT_EQ(d[0].box, expected[0].box);
+    EXPECT_EQ(d[0].score, expected[0].score);
+  }
+  // Too few valid cells (depthMinCells) count as none: only two columns measured per window core.
+  LayerStack sparse(400, 200);
+  cv::Mat1f d(200, 400, 0.f);
+  d(cv::Rect(0, 0, 100, 200)).setTo(10.f);
+  d(cv::Rect(100, 0, 300, 200)).setTo(20.f);
+  cv::Mat mask = cv::Mat::zeros(200, 400, CV_8U);
+  mask(cv::Rect(0, 70, 400, 1)).setTo(1);  // one band row: 31 cells per core
+  sparse.set(Layer{std::string(layer::kDistance), d, mask});
+  GroupParams p = depthLinked(0.1, 0);
+  EXPECT_EQ(groupHits(hits, p, "car", sparse).size(), 2u);
+  p.depthMinCells = 32;
+  EXPECT_EQ(groupHits(hits, p, "car", sparse).size(), 1u);
+}
+
+// Random hits on a random depth layer: off, the rule is cv::groupRectangles' whatever the laser
+// says; on, its groups only split the edge rule's (no hit's group grows).
+TEST(Grouping, DepthLinkOnlySplitsTheEdgeRulesGroups) {
+  std::mt19937 rng(5);
+  int split = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    const auto hits = randomHits(seed, 3 + int(seed % 12));
+    LayerStack stack(640, 480);
+    cv::Mat1f d(120, 160);
+    cv::randu(d, cv::Scalar(-5.f), cv::Scalar(40.f));  // below 0: not measured
+    stack.set(Layer{std::string(layer::kDistance), d, {}});
+    std::vector<cv::Rect> rects;
+    for (const RawHit& h : hits) rects.emplace_back(int(h.box.x), int(h.box.y), int(h.box.w), int(h.box.h));
+    std::vector<int> weights;
+    cv::groupRectangles(rects, weights, 1, 0.2);
+    GroupParams off;
+    off.minNeighbors = 1;
+    off.depthRelative = 0.01;  // ignored while depthLink is false
+    const auto o = groupHits(hits, off, "car", stack);
+    ASSERT_EQ(o.size(), rects.size()) << "seed " << seed;
+    for (std::size_t i = 0; i < rects.size(); ++i)
+      EXPECT_EQ(o[i].box, (Box{double(rects[i].x), double(rects[i].y), double(rects[i].width), double(rects[i].height)}));
+    std::vector<HitFate> fOff, fOn;
+    groupHits(hits, off, "car", stack, &fOff);
+    GroupParams on = off;
+    on.depthLink = true;
+    on.depthRelative = double(rng() % 30) / 100.0;
+    groupHits(hits, on, "car", stack, &fOn);
+    for (std::size_t i = 0; i < hits.size(); ++i) {
+      EXPECT_LE(fOn[i].groupSize, fOff[i].groupSize) << "seed " << seed << " hit " << i;
+      split += fOn[i].groupSize < fOff[i].groupSize;
+    }
+  }
+  EXPECT_GT(split, 0);  // the random depths did split some groups
+}
+
 TEST(CvIntegrals, SumSquaredAndTiltedEqualCvIntegral) {
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(7, 3), cv::Size(31, 47), cv::Size(640, 480)}) {
     cv::Mat img(size, CV_8U);

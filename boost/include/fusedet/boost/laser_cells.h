@@ -1,0 +1,55 @@
+#pragma once
+// A stack's `distance` layer read in boxes given in the stack's reference pixels, for depth-aware
+// grouping (grouping.h): the same band, core and median as the laser-extent refinement's
+// reference distance (laser_extent.cpp; not yet shared code).
+//
+// A cell is valid when the layer's mask (if any) is non-zero there and its distance is finite and
+// > 0. A box maps onto the cells through unit coordinates (the layer has its own resolution). Its
+// band is the rows from 35 % to 85 % of its height (a car's body below the windows, which the
+// laser passes through; above the road under it); its core is the band's middle half of columns.
+
+#include <cmath>
+#include <optional>
+
+#include <opencv2/core/mat.hpp>
+
+#include "fusedet/core/box.h"
+#include "fusedet/core/layer_stack.h"
+
+namespace fusedet::boosting {
+
+class LaserCells {
+ public:
+  // empty() when the stack has no (or an empty) distance layer or no reference size.
+  explicit LaserCells(const LayerStack& stack);
+
+  bool empty() const { return d_.empty(); }
+  int cols() const { return d_.cols; }
+  int rows() const { return d_.rows; }
+  bool valid(int r, int c) const {
+    const float v = d_(r, c);
+    return v > 0 && std::isfinite(v) && (mask_.empty() || mask_.at<unsigned char>(r, c) != 0);
+  }
+  float distance(int r, int c) const { return d_(r, c); }
+
+  // A box in cell coordinates: x0 / x1 (left / right edge, fractional), band rows [bandTop, bandEnd).
+  struct Place {
+    double x0 = 0, x1 = 0;
+    int bandTop = 0, bandEnd = 0;
+    double width() const { return x1 - x0; }
+  };
+  Place place(const Box& box) const;
+  int col(double x) const;  // the cell column containing x, clamped to the layer
+  double toReferenceX(double x) const { return x / sx_; }
+
+  // Median distance of the valid cells of the box's core; nullopt with fewer than
+  // max(1, minCells) of them (no laser on the box) or an empty layer.
+  std::optional<double> coreDepth(const Box& box, int minCells) const;
+
+ private:
+  cv::Mat1f d_;
+  cv::Mat mask_;  // empty = every cell measured
+  double sx_ = 1, sy_ = 1;  // cells per reference pixel
+};
+
+}  // namespace fusedet::boosting
