@@ -1202,8 +1202,7 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_option("--small-height", o->smallHeight,
                      "--grouping opencv: groups lower than this many pixels need more than --small-min-neighbors "
-                     "hits instead of --min-neighbors (a small object is covered by fewer scanned windows); 0 = off, "
-                     "as fusedetd's detection.small_height")
+                     "hits instead of --min-neighbors (a small object is covered by fewer scanned windows); 0 = off")
           ->check(CLI::Range(0, 100000))
           ->capture_default_str();
       app.add_option("--small-min-neighbors", o->smallMinNeighbors,
