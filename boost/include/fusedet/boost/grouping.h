@@ -38,6 +38,7 @@ struct GroupParams {
   // depthMinCells valid cells, or a stack without a distance layer, has no depth: it links by the
   // edge rule alone. Why: windows on two neighbouring cars, or on a car and the wall behind it,
   // are otherwise linked transitively and averaged into one box that hits neither.
+  // Measured for car (docs/results "Depth-aware grouping"): a tie across drives, so it is off.
   bool depthLink = false;
   double depthRelative = 0.1;
   double depthMetres = 0;
