@@ -24,24 +24,31 @@ LaserCells::LaserCells(const LayerStack& stack) {
 }
 
 int LaserCells::col(double x) const { return std::clamp(static_cast<int>(std::floor(x)), 0, d_.cols - 1); }
+int LaserCells::row(double y) const { return std::clamp(static_cast<int>(std::floor(y)), 0, d_.rows - 1); }
 
 LaserCells::Place LaserCells::place(const Box& box) const {
-  const auto row = [this](double v) { return std::clamp(static_cast<int>(std::floor(v)), 0, d_.rows - 1); };
   Place p;
   p.x0 = box.x * sx_;
   p.x1 = box.right() * sx_;
-  const double y0 = box.y * sy_, h = box.h * sy_;
-  p.bandTop = row(y0 + kBandTop * h);
-  p.bandEnd = row(y0 + kBandBottom * h) + 1;
+  p.y0 = box.y * sy_;
+  p.h = box.h * sy_;
+  p.bandTop = row(p.y0 + kBandTop * p.h);
+  p.bandEnd = row(p.y0 + kBandBottom * p.h) + 1;
+  p.coreFirst = col(p.x0 + 0.25 * p.width());
+  p.coreLast = col(p.x1 - 0.25 * p.width());
   return p;
 }
 
 std::optional<double> LaserCells::coreDepth(const Box& box, int minCells) const {
   if (empty()) return std::nullopt;
-  const Place p = place(box);
+  return coreDepth(place(box), minCells);
+}
+
+std::optional<double> LaserCells::coreDepth(const Place& at, int minCells) const {
+  if (empty()) return std::nullopt;
   std::vector<float> core;
-  for (int r = p.bandTop; r < p.bandEnd; ++r)
-    for (int c = col(p.x0 + 0.25 * p.width()); c <= col(p.x1 - 0.25 * p.width()); ++c)
+  for (int r = at.bandTop; r < at.bandEnd; ++r)
+    for (int c = at.coreFirst; c <= at.coreLast; ++c)
       if (valid(r, c)) core.push_back(d_(r, c));
   if (static_cast<int>(core.size()) < std::max(1, minCells)) return std::nullopt;
   std::nth_element(core.begin(), core.begin() + static_cast<std::ptrdiff_t>(core.size() / 2), core.end());

@@ -1,12 +1,14 @@
 #pragma once
-// A stack's `distance` layer read in boxes given in the stack's reference pixels, for depth-aware
-// grouping (grouping.h): the same band, core and median as the laser-extent refinement's
-// reference distance (laser_extent.cpp; not yet shared code).
+// A stack's `distance` layer read in boxes given in the stack's reference pixels: the one place
+// that says which laser cells a box covers and what distance the box is at. The laser-extent
+// refinement (laser_extent.h: reference distance, column walk, laserRows) and depth-aware grouping
+// (grouping.h: a hit's depth) both read boxes through it.
 //
 // A cell is valid when the layer's mask (if any) is non-zero there and its distance is finite and
 // > 0. A box maps onto the cells through unit coordinates (the layer has its own resolution). Its
 // band is the rows from 35 % to 85 % of its height (a car's body below the windows, which the
 // laser passes through; above the road under it); its core is the band's middle half of columns.
+// The box's distance (coreDepth) is the median of the core's valid cells.
 
 #include <cmath>
 #include <optional>
@@ -32,19 +34,24 @@ class LaserCells {
   }
   float distance(int r, int c) const { return d_(r, c); }
 
-  // A box in cell coordinates: x0 / x1 (left / right edge, fractional), band rows [bandTop, bandEnd).
+  // A box in cell coordinates: x0 / x1 (left / right edge), y0 (top) and h (height), fractional;
+  // band rows [bandTop, bandEnd), core columns [coreFirst, coreLast].
   struct Place {
-    double x0 = 0, x1 = 0;
+    double x0 = 0, x1 = 0, y0 = 0, h = 0;
     int bandTop = 0, bandEnd = 0;
+    int coreFirst = 0, coreLast = 0;
     double width() const { return x1 - x0; }
   };
-  Place place(const Box& box) const;
+  Place place(const Box& box) const;  // only on a non-empty layer
   int col(double x) const;  // the cell column containing x, clamped to the layer
+  int row(double y) const;  // the cell row containing y, clamped to the layer
   double toReferenceX(double x) const { return x / sx_; }
+  double toReferenceY(double y) const { return y / sy_; }
 
   // Median distance of the valid cells of the box's core; nullopt with fewer than
   // max(1, minCells) of them (no laser on the box) or an empty layer.
   std::optional<double> coreDepth(const Box& box, int minCells) const;
+  std::optional<double> coreDepth(const Place& at, int minCells) const;
 
  private:
   cv::Mat1f d_;

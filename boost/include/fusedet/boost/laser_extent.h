@@ -8,11 +8,13 @@
 // 186; paired interval of the difference +0.02 [-0.005, 0.05]: a tie across drives; `fusedet
 // compare`, boost/README.md).
 //
-// Rule, in the distance layer's cells (the box mapped through unit coordinates):
+// Rule, in the distance layer's cells (the box read through laser_cells.h, which owns the band,
+// the core and the box's distance):
 //  - band: the box's rows from 35 % to 85 % of its height (a car's body below the windows, which
 //    the laser passes through); core: the band's middle half of the columns;
-//  - reference distance d0 = median of the core's valid cells (mask non-zero and distance > 0);
-//    fewer than minCells valid core cells -> the box is returned unchanged (no laser on it);
+//  - reference distance d0 = LaserCells::coreDepth, the median of the core's valid cells (mask
+//    non-zero and distance > 0); fewer than minCells valid core cells -> the box is returned
+//    unchanged (no laser on it);
 //  - a column is on the object when at least minShare of its valid band cells lie within
 //    tolerance of the reference, which then becomes the median of those cells (a car's side seen
 //    at a slant continues; the jump to the background ends); a column without valid cells continues;
