@@ -65,14 +65,10 @@ void detectWithModels(const std::filesystem::path& dir, const LayerStack& stack,
   std::size_t first = 0;
   for (std::size_t i = 0; i < detector.size(); ++i) {
     const auto& c = detector.cascade(i);
-    int neighbours = group.minNeighbors;
-    bool laserExtent = extent.enabled;
-    const char* whose = "general";
-    for (const boosting::ClassGrouping& k : perClass)
-      if (k.className == c.className) neighbours = k.minNeighbors, laserExtent = k.laserExtent, whose = "its own";
+    const boosting::GroupingOfClass g = boosting::groupingFor(c.className, perClass, group, extent);
     std::printf("detect    %-7s %s: %zu stages, %zu detections (%s grouping: %d neighbours, laser extent %s)\n",
-                c.className.c_str(), files[i].filename().string().c_str(), c.stages.size(), work.detections[i], whose,
-                neighbours, laserExtent ? "on" : "off");
+                c.className.c_str(), files[i].filename().string().c_str(), c.stages.size(), work.detections[i],
+                g.own ? "its own" : "general", g.group.minNeighbors, g.extent.enabled ? "on" : "off");
     for (std::size_t n = first; n < first + work.detections[i]; ++n) {
       const Detection& d = all[n];
       double best = 0;

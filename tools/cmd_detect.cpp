@@ -145,8 +145,7 @@ int runDetect(const DetectOptions& o) {
   const SetForEveryClass given{false, false, o.minNeighbors.has_value(), o.laserExtent};
   const std::vector<ClassGrouping> perClass =
       o.classDetection ? classGroupings(detector, group, extent, given) : std::vector<ClassGrouping>{};
-  const int neighbours = perClass.empty() ? group.minNeighbors : perClass.front().minNeighbors;
-  const bool laserExtent = perClass.empty() ? extent.enabled : perClass.front().laserExtent;
+  const GroupingOfClass grouping = groupingFor(c.className, perClass, group, extent);
 
   const auto t0 = std::chrono::steady_clock::now();
   PerClassWork work;  // the model's aspect cascades too, merged by the one rule (aspect_cascades.h)
@@ -159,9 +158,9 @@ int runDetect(const DetectOptions& o) {
               ms);
   const std::string method = group.method == GroupParams::Method::kNms
                                  ? "nms (IoU " + std::to_string(group.iouThreshold).substr(0, 4) + ")"
-                                 : "opencv, " + std::to_string(neighbours) + " neighbours";
-  std::printf("  %s grouping: %s, laser extent %s\n", perClass.empty() ? "general" : "class's own", method.c_str(),
-              laserExtent ? "on" : "off");
+                                 : "opencv, " + std::to_string(grouping.group.minNeighbors) + " neighbours";
+  std::printf("  %s grouping: %s, laser extent %s\n", grouping.own ? "class's own" : "general", method.c_str(),
+              grouping.extent.enabled ? "on" : "off");
   for (const Detection& d : dets)
     std::printf("  %s score %.4g  x %.0f y %.0f w %.0f h %.0f\n", d.className.c_str(), d.score, d.box.x, d.box.y,
                 d.box.w, d.box.h);

@@ -70,6 +70,18 @@ std::vector<ClassGrouping> classGroupings(const MultiDetector& detector, const G
   return classGroupings(names, group, extent, given);
 }
 
+GroupingOfClass groupingFor(const std::string& className, const std::vector<ClassGrouping>& perClass,
+                            const GroupParams& group, const LaserExtentParams& extent) {
+  GroupingOfClass out{group, extent, false};
+  const auto own = std::find_if(perClass.begin(), perClass.end(),
+                                [&](const ClassGrouping& c) { return c.className == className; });
+  if (own == perClass.end()) return out;
+  out.group.minNeighbors = own->minNeighbors;
+  out.extent.enabled = own->laserExtent;
+  out.own = true;
+  return out;
+}
+
 std::vector<Detection> detectPerClass(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                                       const GroupParams& group, const LaserExtentParams& extent,
                                       const std::vector<ClassGrouping>& perClass, PerClassWork* work) {
@@ -84,17 +96,9 @@ std::vector<Detection> detectPerClass(const MultiDetector& detector, const Layer
   }
   std::vector<Detection> out;
   for (std::size_t i = 0; i < hits.size(); ++i) {
-    const std::string& name = detector.cascade(i).className;
-    GroupParams g = group;
-    LaserExtentParams e = extent;
-    const auto own = std::find_if(perClass.begin(), perClass.end(),
-                                  [&](const ClassGrouping& c) { return c.className == name; });
-    if (own != perClass.end()) {
-      g.minNeighbors = own->minNeighbors;
-      e.enabled = own->laserExtent;
-    }
-    std::vector<Detection> d = groupModelHits(detector.cascade(i), hits[i], g, stack);
-    refineToLaserExtent(d, stack, e);
+    const GroupingOfClass g = groupingFor(detector.cascade(i).className, perClass, group, extent);
+    std::vector<Detection> d = groupModelHits(detector.cascade(i), hits[i], g.group, stack);
+    refineToLaserExtent(d, stack, g.extent);
     if (work) work->detections.push_back(d.size());
     out.insert(out.end(), std::make_move_iterator(d.begin()), std::make_move_iterator(d.end()));
   }

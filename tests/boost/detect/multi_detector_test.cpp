@@ -429,6 +429,32 @@ TEST(ClassDetection, GroupingsComeFromTheClassDefaultsUnlessSetForEveryClass) {
   EXPECT_FALSE(person.laserExtent.enabled);
 }
 
+// groupingFor(): the class's entry replaces only min neighbours and laser extent; a class without
+// an entry keeps the general settings.
+TEST(ClassDetection, GroupingForTakesTheClassEntryOrTheGeneralSettings) {
+  GroupParams general;
+  general.minNeighbors = 4;
+  general.eps = 0.3;
+  LaserExtentParams extent;
+  extent.tolerance = 2.0;
+  const std::vector<ClassGrouping> perClass{{"car", 16, true}, {"bike", 7, false}};
+  const GroupingOfClass car = groupingFor("car", perClass, general, extent);
+  EXPECT_TRUE(car.own);
+  EXPECT_EQ(car.group.minNeighbors, 16);
+  EXPECT_EQ(car.group.eps, 0.3);
+  EXPECT_TRUE(car.extent.enabled);
+  EXPECT_EQ(car.extent.tolerance, 2.0);
+  const GroupingOfClass bike = groupingFor("bike", perClass, general, extent);
+  EXPECT_TRUE(bike.own);
+  EXPECT_EQ(bike.group.minNeighbors, 7);
+  EXPECT_FALSE(bike.extent.enabled);
+  const GroupingOfClass person = groupingFor("person", perClass, general, extent);
+  EXPECT_FALSE(person.own);
+  EXPECT_EQ(person.group.minNeighbors, 4);
+  EXPECT_FALSE(person.extent.enabled);
+  EXPECT_FALSE(groupingFor("car", {}, general, extent).own);
+}
+
 TEST(MultiDetector, MissingLayerIsNamed) {
   const MultiDetector all(bundledModels());
   LayerStack s = kittiStacks().front();

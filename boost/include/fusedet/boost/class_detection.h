@@ -67,6 +67,17 @@ std::vector<ClassGrouping> classGroupings(const std::vector<std::string>& classN
 std::vector<ClassGrouping> classGroupings(const MultiDetector& detector, const GroupParams& group = {},
                                           const LaserExtentParams& extent = {}, const SetForEveryClass& given = {});
 
+// The grouping one class gets after the shared scan: `group` / `extent` with the minNeighbors /
+// laser extent of the class's entry in `perClass` if it has one (`own`), else unchanged. The one
+// lookup detectPerClass() groups with and commands print.
+struct GroupingOfClass {
+  GroupParams group;
+  LaserExtentParams extent;
+  bool own = false;
+};
+GroupingOfClass groupingFor(const std::string& className, const std::vector<ClassGrouping>& perClass,
+                            const GroupParams& group, const LaserExtentParams& extent);
+
 // Work done by detectPerClass(), per model (index = model order).
 struct PerClassWork {
   std::vector<ScanStats> scans;
