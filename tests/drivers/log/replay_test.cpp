@@ -255,6 +255,101 @@ TEST(Replay, RestampShiftsEverythingByOneOffset) {
   for (std::size_t i = 0; i < a.scans.size(); ++i) EXPECT_EQ(c.scans[i].stamp - a.scans[i].stamp, later);
 }
 
+namespace {
+
+// The laser line of `kScans` scans at 75 Hz (scan s's telegram starts at kT0 + s x 13.33 ms
+// + `delay` from scan `delayFrom` on), one byte every 20 us; `noiseAfter` bytes follow scan
+// `noiseAt`'s telegram. Reads are those of a reader on time: 64 bytes at most, stamped when their
+// last byte arrived - except that scan `lateAt`'s telegram is read late: its first 64 bytes on
+// time, then nothing until scan `lateAt + 3`'s telegram has arrived, which is read together with
+// the rest in one read (a reader thread descheduled for ~40 ms).
+struct Line {
+  int delayFrom = kScans;
+  std::int64_t delay = 0;
+  int noiseAt = -1;
+  std::vector<std::uint8_t> noiseAfter;
+  int lateAt = -1;
+};
+Sample writeLine(const std::string& name, const Line& line) {
+  Sample out;
+  out.path = fs::temp_directory_path() / ("fusedet_replay_" + std::to_string(::getpid()) + "_" + name);
+  Recorder rec(out.path, {}, std::chrono::milliseconds(0));
+  const std::int64_t byteNs = 20'000;
+  std::vector<std::uint8_t> pending;  // bytes a late read has not taken yet
+  for (int s = 0; s < kScans; ++s) {
+    const std::int64_t start = kT0 + s * 13'333'333 + (s >= line.delayFrom ? line.delay : 0);
+    out.scanStarts.push_back(start);
+    std::vector<std::uint8_t> bytes = scanTelegram(s);
+    if (s == line.noiseAt) bytes.insert(bytes.end(), line.noiseAfter.begin(), line.noiseAfter.end());
+    for (std::size_t at = 0; at < bytes.size(); at += 64) {
+      const std::size_t n = std::min<std::size_t>(64, bytes.size() - at);
+      pending.insert(pending.end(), bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(at + n));
+      const bool held = line.lateAt >= 0 && s >= line.lateAt && s < line.lateAt + 3 && !(s == line.lateAt && at == 0);
+      const bool lastOfLate = s == line.lateAt + 3 && at + n == bytes.size();
+      if (held || (s == line.lateAt + 3 && !lastOfLate)) continue;
+      rec.record(SerialChunk{Stamp{start + static_cast<std::int64_t>(at + n) * byteNs}, "/dev/ttyUSB0", kBaud, pending});
+      pending.clear();
+    }
+  }
+  rec.close();
+  return out;
+}
+
+void expectEveryScanInOrder(const Collected& c) {
+  ASSERT_EQ(c.scans.size(), static_cast<std::size_t>(kScans));
+  for (int i = 0; i < kScans; ++i) {
+    EXPECT_NEAR(c.scans[static_cast<std::size_t>(i)].ranges[7], rangeMm(i, 7) * 1e-3, 1e-6) << "scan " << i;
+    EXPECT_EQ(c.scans[static_cast<std::size_t>(i)].sequence, static_cast<std::uint64_t>(i));
+  }
+}
+
+}  // namespace
+
+// A reader thread that was late reads a telegram's rest ~40 ms after its start: the live link saw
+// no silence and completed the telegram, and so must replay (it used to take the gap between the
+// two reads for a silence and give the telegram up: one recorded scan fewer, and every later scan
+// paired with the live scan before it - the rig test's stamp failures under load).
+TEST(Replay, TelegramReadLateInTwoPiecesIsNotGivenUp) {
+  Line line;
+  line.lateAt = 10;
+  const Sample s = writeLine("late.mcap", line);
+  SensorReplay r(s.path, rig());
+  Collected c;
+  SensorReplay::Handlers h;
+  h.scan = [&](const LaserScan& x) { c.scans.push_back(x); };
+  r.run(h);
+  expectEveryScanInOrder(c);
+  EXPECT_EQ(r.counters().telegrams.expired, 0u);
+  EXPECT_EQ(r.counters().telegrams.skippedBytes, 0u);
+  // Scans read on time keep their line stamps; scan 13's telegram ends its late read.
+  for (int i : {0, 9, 13, 14, 29}) EXPECT_EQ(c.scans[static_cast<std::size_t>(i)].stamp.ns, s.scanStarts[static_cast<std::size_t>(i)]) << i;
+  for (int i = 10; i < 14; ++i) EXPECT_LT(c.scans[static_cast<std::size_t>(i) - 1].stamp, c.scans[static_cast<std::size_t>(i)].stamp);
+  fs::remove(s.path);
+}
+
+// Garbage that looks like the start of a long frame (STX, device address, length 400), then 30 ms
+// of silence: the live link gives it up after the silence; replay rejects it by its CRC once the
+// 406 bytes it claims have come and searches them again - the same telegrams with their line stamps.
+TEST(Replay, GarbageFrameBeforeASilenceCostsNoTelegram) {
+  Line line;
+  line.noiseAt = 19;
+  line.noiseAfter = {lms291::kStx, 0x80, 0x90, 0x01};
+  line.delayFrom = 20;
+  line.delay = 30'000'000;
+  const Sample s = writeLine("garbage.mcap", line);
+  SensorReplay r(s.path, rig());
+  Collected c;
+  SensorReplay::Handlers h;
+  h.scan = [&](const LaserScan& x) { c.scans.push_back(x); };
+  r.run(h);
+  expectEveryScanInOrder(c);
+  for (int i = 0; i < kScans; ++i)
+    EXPECT_EQ(c.scans[static_cast<std::size_t>(i)].stamp.ns, s.scanStarts[static_cast<std::size_t>(i)]) << "scan " << i;
+  EXPECT_EQ(r.counters().telegrams.crcErrors, 1u);
+  EXPECT_EQ(r.counters().telegrams.skippedBytes, 4u);  // the garbage: 02 80 90 01
+  fs::remove(s.path);
+}
+
 TEST(Replay, CutLogReplaysItsCompleteChunks) {
   mcap::WriterOptions o;
   o.chunkBytes = 4096;

@@ -136,7 +136,6 @@ class SensorReplay {
   lms291::ScanDecoder scans_;
   canopen::TiltTpdoDecoder tilt_;
   int baud_ = 0;
-  Stamp lastSerial_{};
   std::uint64_t frames_ = 0;
 };
 
