@@ -88,6 +88,11 @@ struct ExperimentOptions {
   bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
   double boxFitLambda = boosting::BoxFitParams{}.lambda;
   double boxFitMinIou = boosting::BoxFitParams{}.minIou;
+  std::string verifier = "off";  // off | logistic | gate: group verifier per fold (boost/group_verifier.h)
+  double verifierLambda = boosting::VerifierParams{}.lambda;
+  std::string verifierFeatures = "all";  // all | compact | physical
+  double verifierLabelIou = 0;
+  bool verifierRescore = true;
   // Per-class detection settings (boost/class_detection.h, car) where the preset uses them; an
   // option given on the command line applies to every class instead.
   bool classDetection = true;
@@ -453,6 +458,17 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
     fit.minIou = o.boxFitMinIou;
     spec.boxFit = fit;
   }
+  if (o.verifier != "off") {
+    boosting::VerifierParams v;
+    v.kind = o.verifier == "gate" ? boosting::VerifierParams::Kind::kHeightGate : boosting::VerifierParams::Kind::kLogistic;
+    v.lambda = o.verifierLambda;
+    v.features = o.verifierFeatures == "compact"    ? boosting::VerifierParams::Features::kCompact
+                 : o.verifierFeatures == "physical" ? boosting::VerifierParams::Features::kPhysical
+                                                    : boosting::VerifierParams::Features::kAll;
+    v.labelIou = o.verifierLabelIou;
+    v.rescore = o.verifierRescore;
+    spec.verifier = v;
+  }
   return spec;
 }
 
@@ -660,6 +676,14 @@ int runExperiments(ExperimentOptions o) {
        o.boxFit ? "on: per fold fitted on its training frames' detections matched at IoU >= " + shortNum(o.boxFitMinIou) +
                       ", ridge lambda " + shortNum(o.boxFitLambda) + " (boost/box_regression.h)"
                 : "off"},
+      {"group verifier (--verifier)",
+       o.verifier == "logistic" ? "logistic: per fold fitted on its training frames' detections (hit or false alarm), L2 lambda " +
+                                      shortNum(o.verifierLambda) + ", " + o.verifierFeatures + " features" +
+                                      (o.verifierLabelIou > 0 ? ", hits at IoU " + shortNum(o.verifierLabelIou) : std::string()) +
+                                      (o.verifierRescore ? "" : ", scores kept") +
+                                      ", threshold at the highest training F (boost/group_verifier.h)"
+       : o.verifier == "gate"   ? "gate: per fold, pixel height x distance within the 2nd-98th percentiles of its training hits'"
+                                : "off"},
       {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
@@ -1236,6 +1260,33 @@ const bool registered = registerCommand(
       app.add_option("--box-fit-min-iou", o->boxFitMinIou,
                      "--box-fit: a training detection is a sample when it overlaps its best positive label by this IoU")
           ->check(CLI::Range(0.05, 1.0))
+          ->capture_default_str();
+      app.add_option("--verifier", o->verifier,
+                     "group verifier (boost/group_verifier.h), per fold fitted on the fold's TRAINING frames with its "
+                     "cascades and applied to its held-out frames: 'logistic' = an L2-regularised logistic regression "
+                     "on each group's member, cascade-margin, box and laser features (distance, pixel height x "
+                     "distance, measured share, spread, height above ground) whose probability becomes the score, "
+                     "groups below the threshold with the highest training F dropped; 'gate' = drop groups whose "
+                     "pixel height x distance lies outside the 2nd-98th percentiles of the training hits'; 'off'. "
+                     "Combine with a low --min-neighbors (the floor the groups are kept at). Default: off")
+          ->check(CLI::IsMember({"off", "logistic", "gate"}))
+          ->capture_default_str();
+      app.add_option("--verifier-lambda", o->verifierLambda, "--verifier logistic: L2 penalty on standardised features (> 0)")
+          ->check(CLI::PositiveNumber)
+          ->capture_default_str();
+      app.add_option("--verifier-features", o->verifierFeatures,
+                     "--verifier logistic: the features it weighs: 'all'; 'compact' = member count, aspect, height, "
+                     "cascade margins, laser and height-above-ground cues (no box or member edges); 'physical' = "
+                     "member count, laser and height-above-ground cues and their squares")
+          ->check(CLI::IsMember({"all", "compact", "physical"}))
+          ->capture_default_str();
+      app.add_flag("!--verifier-keep-score", o->verifierRescore,
+                   "--verifier logistic: only filter groups; a kept group's score stays its member count (default: "
+                   "the verifier's probability becomes the score)");
+      app.add_option("--verifier-label-iou", o->verifierLabelIou,
+                     "--verifier: a training detection counts as a hit when it overlaps a positive label by this IoU "
+                     "(0 = the evaluation's rule, e.g. the devkit's 0.7 for car)")
+          ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       app.add_flag("!--no-class-detection", o->classDetection,
                    "detect every class with the general settings (--scale-factor, --step, --min-neighbors, "

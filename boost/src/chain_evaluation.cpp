@@ -23,7 +23,10 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
       const HitFate& f = fates[k][i];
       // Members only: a hit suppressed by NMS is not.
       if (f.outcome == HitFate::Outcome::kKept && f.detection >= 0 && static_cast<std::size_t>(f.detection) < g.size())
+      {
         g[static_cast<std::size_t>(f.detection)].members.push_back(hits[k][i].box);
+        g[static_cast<std::size_t>(f.detection)].memberScores.push_back(hits[k][i].score);
+      }
     }
   refineToLaserExtent(detections, stack, extent);
   for (std::size_t i = 0; i < detections.size(); ++i) {
@@ -65,6 +68,12 @@ std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain
     }
     dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);  // stretches alone
   }
+  if (setup.verifier.fitted()) {
+    std::vector<GroupedBox> formed;
+    refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, &formed);
+    verifyGroups(dets, formed, fates, stack, setup.verifier);
+    return dets;
+  }
   refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);
   return dets;
 }
@@ -76,6 +85,7 @@ std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& cha
                                          ScanStats* stats) {
   DetectionSetup unrefined = setup;
   unrefined.boxRegression = {};
+  unrefined.verifier = {};
   return detectAndRefine(chain, stack, unrefined, &groups, stats);
 }
 
@@ -108,6 +118,33 @@ BoxRegression fitBoxRefinement(const std::vector<const Detector*>& chain, const 
     }
   }
   return fitBoxRegression(features, targets, params);
+}
+
+GroupVerifier fitGroupVerification(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
+                                   const std::vector<std::size_t>& indices, const MatchConfig& match,
+                                   const DetectionSetup& setup, const VerifierParams& params) {
+  std::vector<std::vector<double>> features;
+  std::vector<bool> isHit;
+  std::size_t positives = 0;
+  for (std::size_t i : indices) {
+    const DatasetItem& item = items.at(i);
+    std::vector<GroupedBox> groups;
+    std::vector<Detection> dets = detectChainGroups(chain, item.stack, setup, groups);
+    for (std::size_t d = 0; d < dets.size(); ++d) {  // the boxes the evaluation scores
+      dets[d].box = setup.boxRegression.refine(groups[d], item.stack);
+      dets[d].unitBox = item.stack.toUnit(dets[d].box);
+    }
+    MatchConfig labelling = match;
+    if (params.labelIou > 0) labelling.minIou = params.labelIou;
+    const StackMatch m = matchDetections(dets, item.labels, labelling);
+    positives += m.positives;
+    for (std::size_t d = 0; d < dets.size(); ++d) {
+      if (m.detections[d] == DetectionOutcome::kIgnored) continue;
+      features.push_back(groupFeatures(groups[d], item.stack));
+      isHit.push_back(m.detections[d] == DetectionOutcome::kHit);
+    }
+  }
+  return fitGroupVerifier(features, isHit, positives, params);
 }
 
 EvalOutcome evaluateChain(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,

@@ -200,6 +200,17 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
                                                     " training detections"
                                               : "not fitted (" + foldSetup.boxRegression.why + ")"));
     }
+    if (spec.verifier) {
+      foldSetup.verifier = fitGroupVerification(chain, testItems, fold.train, match, foldSetup, *spec.verifier);
+      out.verifiers.push_back(foldSetup.verifier);
+      if (log) {
+        const GroupVerifier& v = foldSetup.verifier;
+        log("fold " + shortName + ": group verifier " +
+            (v.fitted() ? "fitted on " + std::to_string(v.samples) + " training detections (" + std::to_string(v.hits) +
+                              " hits)"
+                        : "not fitted (" + v.why + ")"));
+      }
+    }
     const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, foldSetup);
     for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
     // The analysis detects on its own; it must see exactly what the evaluation saw.

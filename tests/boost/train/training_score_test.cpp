@@ -228,5 +228,50 @@ TEST(TrainingScore, BoxRefinementFittedPerFoldOnItsTrainingItems) {
   }
 }
 
+// ChainSpec::verifier: each trained fold fits the group verifier on ITS OWN training items with its
+// own cascade (the same fit as fitGroupVerification() with a cascade trained here), and the
+// held-out items do not inform the fit: replacing them changes nothing.
+TEST(TrainingScore, GroupVerifierFittedPerFoldOnItsTrainingItemsOnly) {
+  const std::vector<DatasetItem> items = twoDrives();
+  const std::vector<Fold> folds = foldsOf(items);  // fold 0 trains on "full", tests "empty"
+  ASSERT_EQ(folds.size(), 2u);
+  const MatchConfig match = carMatch();
+  const DetectionSetup setup = fineSetup();
+  const TrainingConfig config = oneThreadConfig();
+  ChainSpec spec{{config}};
+  VerifierParams params;
+  params.minSamples = 3;
+  params.labelIou = 0.2;  // the small cascade places its boxes loosely
+  spec.verifier = params;
+  NullProgress quiet;
+  const CrossValidationResult r = crossValidate(spec, items, items, folds, match, setup, {}, quiet);
+  ASSERT_EQ(r.verifiers.size(), 1u);  // the untrainable fold has none
+  const Detector det = trainedLike(items, folds[0], config);
+  const GroupVerifier want = fitGroupVerification({&det}, items, folds[0].train, match, setup, params);
+  ASSERT_TRUE(want.fitted()) << want.why;
+  EXPECT_GT(want.hits, 0u);
+  EXPECT_LT(want.hits, want.samples);
+  EXPECT_EQ(r.verifiers[0].samples, want.samples);
+  ASSERT_EQ(r.verifiers[0].weights.size(), want.weights.size());
+  for (std::size_t j = 0; j < want.weights.size(); ++j) EXPECT_DOUBLE_EQ(r.verifiers[0].weights[j], want.weights[j]);
+  EXPECT_DOUBLE_EQ(r.verifiers[0].threshold, want.threshold);
+  // The held-out items replaced by scenes full of cars: the same fit.
+  std::vector<DatasetItem> changed = items;
+  for (std::size_t k = 0; k < folds[0].test.size(); ++k) {
+    DatasetItem other = synthetic::scene(900 + static_cast<unsigned>(k), 2, false);
+    other.group = changed[folds[0].test[k]].group;
+    changed[folds[0].test[k]] = std::move(other);
+  }
+  const GroupVerifier same = fitGroupVerification({&det}, changed, folds[0].train, match, setup, params);
+  EXPECT_EQ(same.samples, want.samples);
+  EXPECT_EQ(same.hits, want.hits);
+  for (std::size_t j = 0; j < want.weights.size(); ++j) EXPECT_DOUBLE_EQ(same.weights[j], want.weights[j]);
+  EXPECT_DOUBLE_EQ(same.intercept, want.intercept);
+  // ...while fitting on them would change it.
+  std::vector<std::size_t> withTest = folds[0].train;
+  withTest.insert(withTest.end(), folds[0].test.begin(), folds[0].test.end());
+  EXPECT_NE(fitGroupVerification({&det}, changed, withTest, match, setup, params).samples, want.samples);
+}
+
 }  // namespace
 }  // namespace fusedet::boosting

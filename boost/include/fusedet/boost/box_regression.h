@@ -47,6 +47,7 @@ struct GroupedBox {
   Box box;
   Box groupBox;
   std::vector<Box> members;  // empty: NMS's single hit, or no member information (the box itself)
+  std::vector<double> memberScores;  // per member: its last-stage sum (group_verifier.h reads them)
 };
 
 // The feature vector above (boxFeatureCount() entries, all finite).

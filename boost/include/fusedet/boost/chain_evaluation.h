@@ -10,6 +10,7 @@
 #include "fusedet/boost/box_regression.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
+#include "fusedet/boost/group_verifier.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"
 #include "fusedet/boost/precision_recall.h"
@@ -22,6 +23,7 @@ struct DetectionSetup {
   GroupParams group;
   LaserExtentParams laserExtent;  // box refinement after grouping (off by default)
   BoxRegression boxRegression{};  // learned refinement after the laser extent (none by default)
+  GroupVerifier verifier{};       // learned group verifier after the boxes (none by default)
 };
 
 struct EvalOutcome {
@@ -48,7 +50,8 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
                  const LaserExtentParams& extent, const BoxRegression& regression,
                  std::vector<GroupedBox>* groups = nullptr);
 
-// Detections of the chain before `setup.boxRegression`, each with what formed it (box_regression.h).
+// Detections of the chain before `setup.boxRegression` and `setup.verifier`, each with what formed
+// it (box_regression.h).
 std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                          const DetectionSetup& setup, std::vector<GroupedBox>& groups,
                                          ScanStats* stats = nullptr);
@@ -60,6 +63,14 @@ std::vector<Detection> detectChainGroups(const std::vector<const Detector*>& cha
 BoxRegression fitBoxRefinement(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
                                const std::vector<std::size_t>& indices, const MatchConfig& match,
                                const DetectionSetup& setup, const BoxFitParams& params);
+
+// Fits the group verifier (group_verifier.h) on items[indices] (a fold's TRAINING frames): every
+// detection of the chain (setup without its verifier, with its box regression) scored a hit or a
+// false alarm by `match` is a sample (ignored ones are not); the items' positives count for the
+// operating threshold's F.
+GroupVerifier fitGroupVerification(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,
+                                   const std::vector<std::size_t>& indices, const MatchConfig& match,
+                                   const DetectionSetup& setup, const VerifierParams& params);
 
 // Runs the chain on every item and matches against its labels.
 EvalOutcome evaluateChain(const std::vector<const Detector*>& chain, const std::vector<DatasetItem>& items,

@@ -73,6 +73,8 @@ struct CrossValidationResult {
   std::vector<std::vector<PositiveOutcome>> trainingPositives;
   // With ChainSpec::boxFit: per trained fold, the refinement fitted on its training items.
   std::vector<BoxRegression> boxFits;
+  // With ChainSpec::verifier: per trained fold, the group verifier fitted on its training items.
+  std::vector<GroupVerifier> verifiers;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -92,6 +94,10 @@ struct ChainSpec {
   // with the fold's cascades, apply it on its held-out items (and its training items when they are
   // scored): no held-out frame informs its own boxes. Unset = the setup's (none by default).
   std::optional<BoxFitParams> boxFit{};
+  // Fit the group verifier (group_verifier.h) per fold alike: on the fold's own training items,
+  // with its cascades and its box refinement; applied on its held-out items (and its scored
+  // training items). Unset = the setup's (none by default).
+  std::optional<VerifierParams> verifier{};
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
