@@ -8,6 +8,8 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
+#include "fusedet/boost/laser_cells.h"
+
 namespace fusedet::boosting {
 
 namespace {
@@ -15,8 +17,9 @@ namespace {
 constexpr std::size_t kMarginFeatures = 3, kLaserFeatures = 6, kHeightFeatures = 3, kSquareFeatures = 2;
 constexpr int kMinLaserCells = 6;  // as the laser extent's reference distance needs
 
-// Measured values of `layer` inside the rows [top, bottom) and columns [left, right) given as
-// fractions of `box` (reference pixels); `cells` gets the number of cells looked at.
+// Measured values of `layer` (the height layer; the distance layer is read through laser_cells.h)
+// inside the rows [top, bottom) and columns [left, right) given as fractions of `box` (reference
+// pixels); `cells` gets the number of cells looked at.
 std::vector<float> valuesIn(const Layer& layer, const LayerStack& stack, const Box& box, double left, double right,
                             double top, double bottom, std::size_t& cells) {
   std::vector<float> out;
@@ -87,12 +90,14 @@ std::vector<double> groupFeatures(const GroupedBox& g, const LayerStack& stack) 
   }
   const Box& b = g.box;
   const bool sized = b.w > 0 && b.h > 0;
-  // Laser: the distance cells of the box's band (the body below the windows, laser_extent.h).
+  // Laser: the valid distance cells of the box's core (laser_cells.h: the band's middle columns).
   std::size_t cells = 0;
   std::vector<float> d;
-  if (const Layer* layer = stack.find(layer::kDistance); layer && sized) {
-    d = valuesIn(*layer, stack, b, 0.25, 0.75, 0.35, 0.85, cells);
-    std::erase_if(d, [](float x) { return !(x > 0); });  // 0 = no echo
+  if (const LaserCells laser(stack); !laser.empty() && sized) {
+    const LaserCells::Place at = laser.place(b);
+    for (int r = at.bandTop; r < at.bandEnd; ++r)
+      for (int c = at.coreFirst; c <= at.coreLast; ++c, ++cells)
+        if (laser.valid(r, c)) d.push_back(laser.distance(r, c));
   }
   if (static_cast<int>(d.size()) >= kMinLaserCells) {
     const double share = static_cast<double>(d.size()) / static_cast<double>(std::max<std::size_t>(1, cells));

@@ -73,7 +73,7 @@ TEST(BoxRegression, NoFitIsTheIdentity) {
   const BoxRegression none;
   EXPECT_FALSE(none.fitted());
   const LayerStack s(100, 50);
-  const GroupedBox g{Box{10, 5, 30, 20}, Box{12, 5, 28, 20}, {}};
+  const GroupedBox g{Box{10, 5, 30, 20}, Box{12, 5, 28, 20}, {}, {}};
   EXPECT_EQ(none.refine(g, s), g.box);
   EXPECT_EQ(none.predict(std::vector<double>(3, 1.0)), (BoxTargets{0, 0, 0, 0}));
 }
@@ -177,7 +177,7 @@ TEST(BoxRegression, FeaturesOfAHandDrawnScene) {
   cv::Mat1f d(50, 100, 30.f);
   d(cv::Rect(20, 10, 40, 30)).setTo(10.f);
   s.set(Layer{std::string(layer::kDistance), d, {}});
-  const GroupedBox g{Box{25, 10, 30, 30}, Box{27, 10, 26, 30}, {Box{25, 10, 30, 30}, Box{29, 10, 22, 30}}};
+  const GroupedBox g{Box{25, 10, 30, 30}, Box{27, 10, 26, 30}, {Box{25, 10, 30, 30}, Box{29, 10, 22, 30}}, {}};
   const std::vector<double> f = boxFeatures(g, s);
   ASSERT_EQ(f.size(), boxFeatureCount());
   EXPECT_NEAR(f[0], 2.0 / 30, 1e-12);
@@ -199,14 +199,14 @@ TEST(BoxRegression, FeaturesOfAHandDrawnScene) {
 
 TEST(BoxRegression, FeaturesOfDegenerateInputsAreFinite) {
   const LayerStack noLaser(100, 50);
-  for (const GroupedBox& g : {GroupedBox{Box{25, 10, 30, 30}, Box{25, 10, 30, 30}, {}},
-                              GroupedBox{Box{25, 10, 0, 30}, Box{}, {}},
-                              GroupedBox{Box{25, 10, 30, 30}, Box{0, 0, 0, 0}, {Box{}, Box{1e300, 0, 1, 1}}}}) {
+  for (const GroupedBox& g : {GroupedBox{Box{25, 10, 30, 30}, Box{25, 10, 30, 30}, {}, {}},
+                              GroupedBox{Box{25, 10, 0, 30}, Box{}, {}, {}},
+                              GroupedBox{Box{25, 10, 30, 30}, Box{0, 0, 0, 0}, {Box{}, Box{1e300, 0, 1, 1}}, {}}}) {
     const std::vector<double> f = boxFeatures(g, noLaser);
     ASSERT_EQ(f.size(), boxFeatureCount());
     for (double v : f) EXPECT_TRUE(std::isfinite(v));
   }
-  EXPECT_EQ(boxFeatures(GroupedBox{Box{25, 10, 30, 30}, Box{25, 10, 30, 30}, {}}, noLaser)[25], 0.0);  // no laser
+  EXPECT_EQ(boxFeatures(GroupedBox{Box{25, 10, 30, 30}, Box{25, 10, 30, 30}, {}, {}}, noLaser)[25], 0.0);  // no laser
 }
 
 // refineBoxes(): members are the hits kept in a detection; an intercept-only fit (dx 0.1, others 0)

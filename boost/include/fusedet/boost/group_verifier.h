@@ -13,8 +13,8 @@
 // Features (groupFeatures(), groupFeatureCount() numbers, all finite):
 //   boxFeatures() of box_regression.h (31: group/member edges, log(1 + members), laser-extent
 //   edges, laser rows, aspect, height, position); the members' last-stage sums (mean, max, min);
-//   from the distance layer's cells in the box's band (rows 35-85 % of its height, middle half of
-//   its columns): whether at least 6 are measured, their share of the band's cells, log median
+//   from the distance layer's cells in the box's core (laser_cells.h: rows 35-85 % of its height,
+//   middle half of its columns): whether at least 6 are measured, their share of the band's cells, log median
 //   distance, their interquartile range / median, log(pixel height x median distance), log(pixel
 //   width x median distance); from the `height` layer's measured cells in the box: whether any,
 //   the 90th percentile (the object's top above the ground), the 10th percentile of its bottom
