@@ -102,6 +102,7 @@ struct Collected {
   std::vector<TiltSample> tilt;
   std::vector<CameraFrame> frames;
   std::vector<std::int64_t> order;  // stamps in delivery order
+  SensorReplayCounters counters;    // at the end
 };
 
 Collected replayAll(const fs::path& p, ReplayOptions o = {}, const std::atomic<bool>* stop = nullptr) {
@@ -112,6 +113,7 @@ Collected replayAll(const fs::path& p, ReplayOptions o = {}, const std::atomic<b
   h.tilt = [&](const TiltSample& t) { c.tilt.push_back(t), c.order.push_back(t.stamp.ns); };
   h.frame = [&](const CameraFrame& f) { c.frames.push_back(f), c.order.push_back(f.stamp.ns); };
   r.run(h, stop);
+  c.counters = r.counters();
   return c;
 }
 
@@ -313,14 +315,10 @@ TEST(Replay, TelegramReadLateInTwoPiecesIsNotGivenUp) {
   Line line;
   line.lateAt = 10;
   const Sample s = writeLine("late.mcap", line);
-  SensorReplay r(s.path, rig());
-  Collected c;
-  SensorReplay::Handlers h;
-  h.scan = [&](const LaserScan& x) { c.scans.push_back(x); };
-  r.run(h);
+  const Collected c = replayAll(s.path);
   expectEveryScanInOrder(c);
-  EXPECT_EQ(r.counters().telegrams.expired, 0u);
-  EXPECT_EQ(r.counters().telegrams.skippedBytes, 0u);
+  EXPECT_EQ(c.counters.telegrams.expired, 0u);
+  EXPECT_EQ(c.counters.telegrams.skippedBytes, 0u);
   // Scans read on time keep their line stamps; scan 13's telegram ends its late read.
   for (int i : {0, 9, 13, 14, 29}) EXPECT_EQ(c.scans[static_cast<std::size_t>(i)].stamp.ns, s.scanStarts[static_cast<std::size_t>(i)]) << i;
   for (int i = 10; i < 14; ++i) EXPECT_LT(c.scans[static_cast<std::size_t>(i) - 1].stamp, c.scans[static_cast<std::size_t>(i)].stamp);
@@ -337,16 +335,12 @@ TEST(Replay, GarbageFrameBeforeASilenceCostsNoTelegram) {
   line.delayFrom = 20;
   line.delay = 30'000'000;
   const Sample s = writeLine("garbage.mcap", line);
-  SensorReplay r(s.path, rig());
-  Collected c;
-  SensorReplay::Handlers h;
-  h.scan = [&](const LaserScan& x) { c.scans.push_back(x); };
-  r.run(h);
+  const Collected c = replayAll(s.path);
   expectEveryScanInOrder(c);
   for (int i = 0; i < kScans; ++i)
     EXPECT_EQ(c.scans[static_cast<std::size_t>(i)].stamp.ns, s.scanStarts[static_cast<std::size_t>(i)]) << "scan " << i;
-  EXPECT_EQ(r.counters().telegrams.crcErrors, 1u);
-  EXPECT_EQ(r.counters().telegrams.skippedBytes, 4u);  // the garbage: 02 80 90 01
+  EXPECT_EQ(c.counters.telegrams.crcErrors, 1u);
+  EXPECT_EQ(c.counters.telegrams.skippedBytes, 4u);  // the garbage: 02 80 90 01
   fs::remove(s.path);
 }
 
