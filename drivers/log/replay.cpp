@@ -119,8 +119,8 @@ void SensorReplay::drainTelegrams(const Handlers& h, int baud) {
 // No silence rule here: the gap between two recorded reads is not a silence on the line. A reader
 // thread that was late (a loaded machine) reads a telegram's rest long after its start; the live
 // link saw no silence and completed it, so giving the start up on that gap lost a whole recorded
-// telegram (seen: 1 replayed telegram fewer than the live link decoded in 3 of 20 rig runs at load
-// ~12, and a replayed scan list shifted by one from the live one). The live link gives a pending
+// telegram (seen: 1-3 replayed telegrams fewer than the live link decoded in 7 of 60 rig runs at
+// load 8-13, and the replayed scan list shifted from the live one). The live link gives a pending
 // frame up only after a silence it waited through; such a frame is garbage (the LMS leaves at most
 // 14 ms inside a telegram), and here its CRC rejects it once the bytes it claims have come, and the
 // reader searches those bytes again: the same telegrams as live.
