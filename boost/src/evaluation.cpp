@@ -148,19 +148,40 @@ CascadeSummary summarizeCascade(const Cascade& cascade) {
   CascadeSummary s;
   s.stages = cascade.stages.size();
   for (const std::string& l : cascade.layers) s.layerWeight[l] = 0;  // listed even when unused
+  // One split on `feature` moving the sum by `weight`.
+  auto addSplit = [&](int feature, double weight) {
+    ++s.splits;
+    std::string layerName = cascade.layers.empty() ? std::string("?") : cascade.layers.front();
+    if (!cascade.isOpenCv()) {
+      const Feature& f = cascade.features.at(static_cast<std::size_t>(feature));
+      layerName = cascade.layers.at(static_cast<std::size_t>(f.layer));
+      if (isCorner(f.type)) ++s.cornerCount;
+    }
+    s.layerWeight[layerName] += weight;
+    ++s.layerCount[layerName];
+  };
   for (const Stage& stage : cascade.stages) {
     for (const Stump& stump : stage.stumps) {
       ++s.length;
-      std::string layerName = cascade.layers.empty() ? std::string("?") : cascade.layers.front();
-      if (!cascade.isOpenCv()) {
-        const Feature& f = cascade.features.at(static_cast<std::size_t>(stump.feature));
-        layerName = cascade.layers.at(static_cast<std::size_t>(f.layer));
-        if (isCorner(f.type)) ++s.cornerCount;
-      }
-      s.layerWeight[layerName] += std::abs(stump.right - stump.left);
-      ++s.layerCount[layerName];
+      addSplit(stump.feature, std::abs(stump.right - stump.left));
     }
   }
+  for (const auto& trees : cascade.treeStages)
+    for (const Tree& t : trees) {
+      ++s.length;
+      // Leaves below each node (children follow their parent: from the last node backwards).
+      std::vector<std::pair<double, double>> range(t.nodes.size());
+      auto rangeOf = [&](int child) {
+        if (child > 0) return range[static_cast<std::size_t>(child)];
+        const double v = t.leaves[static_cast<std::size_t>(-child)];
+        return std::pair{v, v};
+      };
+      for (std::size_t n = t.nodes.size(); n-- > 0;) {
+        const auto l = rangeOf(t.nodes[n].left), r = rangeOf(t.nodes[n].right);
+        range[n] = {std::min(l.first, r.first), std::max(l.second, r.second)};
+      }
+      for (std::size_t n = 0; n < t.nodes.size(); ++n) addSplit(t.nodes[n].feature, range[n].second - range[n].first);
+    }
   computeShares(s);
   return s;
 }
@@ -169,6 +190,7 @@ CascadeSummary combineSummaries(const std::vector<CascadeSummary>& parts) {
   CascadeSummary s;
   for (const CascadeSummary& p : parts) {
     s.length += p.length;
+    s.splits += p.splits;
     s.stages += p.stages;
     s.cornerCount += p.cornerCount;
     for (const auto& [l, w] : p.layerWeight) s.layerWeight[l] += w;

@@ -33,9 +33,15 @@ std::vector<double> softStartWeights(std::span<const double> start, std::size_t 
   return w;
 }
 
-StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
-                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                       const HeldOutPositives* heldOut, std::span<const double> startScores) {
+namespace {
+
+// The Gentle AdaBoost loop of boostStage() and trainTreeStage(). fit(weights, outputs) fits one
+// round's weak learner, writes f(x_i) of every sample to outputs and stores it in the result;
+// heldOutputs(result, outputs) gives the last stored learner's f on the held-out positives.
+template <class Fit, class HeldOutputs>
+StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOutputs&& heldOutputs,
+                        const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
+                        const HeldOutPositives* heldOut, std::span<const double> startScores) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
@@ -52,31 +58,30 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
   if (!startScores.empty()) score.assign(startScores.begin(), startScores.end());
-  std::vector<float> values(n);
+  std::vector<double> outputs(n);
   const std::size_t held = heldOut ? heldOut->count : 0;
   std::vector<double> heldScore(held, 0.0);
-  std::vector<float> heldValues(held);
+  std::vector<double> heldF(held);
   StageResult result;
   for (int round = 1; round <= config.maxWeak; ++round) {
     for (std::size_t i = 0; i < n; ++i) wf[i] = static_cast<float>(w[i]);
-    const FittedStump s = find(wf, values);
+    RoundInfo info = fit(wf, outputs, result);
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double f = s(values[i]);
+      const double f = outputs[i];
       score[i] += f;
       const double y = i < positives ? 1.0 : -1.0;
       w[i] *= std::exp(-y * f);
       sum += w[i];
     }
     for (double& v : w) v /= sum;
-    result.stumps.push_back(s);
     result.trainingThreshold =
         stageThreshold(std::vector<double>(score.begin(), score.begin() + static_cast<std::ptrdiff_t>(positives)),
                        config.minHit);
     result.threshold = result.trainingThreshold;
     if (held > 0) {
-      heldOut->values(s.feature, heldValues);
-      for (std::size_t i = 0; i < held; ++i) heldScore[i] += s(heldValues[i]);
+      heldOutputs(result, heldF);
+      for (std::size_t i = 0; i < held; ++i) heldScore[i] += heldF[i];
       result.threshold = stageThreshold(heldScore, heldOut->minHit);
     }
     std::size_t hits = 0, fas = 0;
@@ -84,13 +89,70 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
       if (score[i] >= result.threshold) (i < positives ? hits : fas)++;
     result.hitRate = double(hits) / double(positives);
     result.falseAlarm = double(fas) / double(n - positives);
-    if (onRound) onRound(RoundInfo{round, result.hitRate, result.falseAlarm, result.threshold, s});
+    if (onRound) {
+      info.round = round;
+      info.hitRate = result.hitRate;
+      info.falseAlarm = result.falseAlarm;
+      info.threshold = result.threshold;
+      onRound(info);
+    }
     if (result.falseAlarm <= config.maxFalseAlarm) {
       result.reachedFalseAlarm = true;
       break;
     }
   }
   return result;
+}
+
+}  // namespace
+
+StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
+                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
+                       const HeldOutPositives* heldOut, std::span<const double> startScores) {
+  std::vector<float> values(n), heldValues(heldOut ? heldOut->count : 0);
+  return boostRounds(
+      n, positives,
+      [&](std::span<const float> weights, std::span<double> outputs, StageResult& result) {
+        const FittedStump s = find(weights, values);
+        for (std::size_t i = 0; i < n; ++i) outputs[i] = s(values[i]);
+        result.stumps.push_back(s);
+        RoundInfo info;
+        info.stump = s;
+        return info;
+      },
+      [&](const StageResult& result, std::span<double> out) {
+        const FittedStump& s = result.stumps.back();
+        heldOut->values(s.feature, heldValues);
+        for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(heldValues[i]);
+      },
+      config, onRound, heldOut, startScores);
+}
+
+StageResult trainTreeStage(const FeatureMatrix& m, std::size_t positives, const FeatureValuesFn& rawValues,
+                           const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
+                           const HeldOutPositives* heldOut, std::span<const double> startScores) {
+  if (config.treeDepth < 1) throw std::invalid_argument("trainTreeStage: tree depth must be >= 1");
+  TreeSearchOptions search;
+  search.depth = config.treeDepth;
+  search.stump.threads = config.threads;
+  search.stump.refineTop = config.refineTop;
+  const std::size_t held = heldOut ? heldOut->count : 0;
+  return boostRounds(
+      m.samples(), positives,
+      [&](std::span<const float> weights, std::span<double> outputs, StageResult& result) {
+        result.trees.push_back(fitRegressionTree(m, positives, weights, rawValues, search, outputs));
+        RoundInfo info;
+        info.tree = &result.trees.back();
+        return info;
+      },
+      [&](const StageResult& result, std::span<double> out) {
+        // Each node's feature on every held-out positive, then each positive's path.
+        const FittedTree& t = result.trees.back();
+        std::vector<std::vector<float>> nodeValues(t.nodes.size(), std::vector<float>(held));
+        for (std::size_t k = 0; k < t.nodes.size(); ++k) heldOut->values(t.nodes[k].feature, nodeValues[k]);
+        for (std::size_t i = 0; i < held; ++i) out[i] = t([&](std::size_t k) { return nodeValues[k][i]; });
+      },
+      config, onRound, heldOut, startScores);
 }
 
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,

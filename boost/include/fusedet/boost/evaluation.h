@@ -88,15 +88,18 @@ std::string formatMeasure(const std::optional<double>& value, int decimals = 2);
 // What a cascade is made of (paper §4, Fig. 7). The weight of a stump is |right - left|, the
 // amount it moves the stage sum between its two sides; its mean (left + right) / 2 is a constant
 // that only shifts the stage threshold, so it says nothing about what the layer contributes.
-// Gentle AdaBoost has no per-round alpha: the leaves are the weighted means themselves.
+// Gentle AdaBoost has no per-round alpha: the leaves are the weighted means themselves. A tree's
+// split node weighs what a stump there would: max - min of the leaves below it (a node above two
+// leaves: |right - left|).
 struct CascadeSummary {
-  std::size_t length = 0;  // weak classifiers (stumps) over all stages
+  std::size_t length = 0;  // weak classifiers (stumps or trees) over all stages
+  std::size_t splits = 0;  // split nodes (= length for stumps)
   std::size_t stages = 0;
-  std::map<std::string, double> layerWeight;       // layer -> summed stump weight
+  std::map<std::string, double> layerWeight;       // layer -> summed split weight
   std::map<std::string, double> layerWeightShare;  // layer -> weight / total weight (sums to 1)
-  std::map<std::string, std::size_t> layerCount;   // layer -> stumps on it
-  std::size_t cornerCount = 0;                     // stumps on corner-like features (g-j)
-  double cornerShare() const { return length ? double(cornerCount) / double(length) : 0.0; }
+  std::map<std::string, std::size_t> layerCount;   // layer -> split nodes on it
+  std::size_t cornerCount = 0;                     // split nodes on corner-like features (g-j)
+  double cornerShare() const { return splits ? double(cornerCount) / double(splits) : 0.0; }
 };
 
 // Summary of one cascade. Imported OpenCV models have one layer and no corner features.

@@ -9,6 +9,7 @@
 // thread count.
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <limits>
 #include <span>
@@ -50,6 +51,13 @@ std::vector<std::size_t> refineOrder(const std::vector<SplitCandidate>& candidat
 std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t positives,
                                              std::span<const float> weights, std::size_t k,
                                              int threads = 0);
+
+// The same over the samples of one tree node (regression_tree.h): `samples` are increasing matrix
+// columns, [0, positives) of them positives, weights[i] the weight of samples[i]. Only their
+// histograms are built, so a node costs in proportion to its samples.
+std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::span<const std::uint32_t> samples,
+                                             std::size_t positives, std::span<const float> weights,
+                                             std::size_t k, int threads = 0);
 
 // Exact weighted least-squares stump of one feature from its raw values (same sample order).
 FittedStump fitStumpExact(std::size_t feature, std::span<const float> values,
