@@ -579,3 +579,45 @@ TEST(CascadeTrainer, SoftCascadeThresholdsAreOnTheCumulativeScoresOfThePositives
   const Found f = findCars(Detector(soft), [](DatasetItem&) {});
   EXPECT_GE(double(f.found), 0.8 * double(f.cars)) << f.found << " of " << f.cars << "; " << report.stopReason;
 }
+
+// Depth-2 regression trees as weak learners (TrainingConfig's stage.treeDepth): the model holds
+// trees (format version 5), is the same for any thread count and for both negative-mining paths
+// (the incremental miner and the full rescan scan tree cascades alike), accepts its training
+// positives at the kept hit rate, and depth 1 is exactly the stump trainer.
+TEST(CascadeTrainer, TreeWeakLearnersTrainDeterministicallyOnEveryMiningPath) {
+  const auto items = scenes(8, true);
+  TrainingConfig c = twoLayerConfig();
+  c.stage.treeDepth = 2;
+  c.stage.maxFalseAlarm = 0.05;
+  c.stage.maxWeak = 8;
+  NullProgress quiet;
+  TrainingReport report;
+  const Cascade trees = trainCascade(c, items, quiet, &report);
+  ASSERT_TRUE(trees.hasTrees());
+  EXPECT_EQ(trees.treeStages.size(), trees.stages.size());
+  std::size_t deeper = 0;
+  for (std::size_t k = 0; k < trees.stages.size(); ++k) {
+    EXPECT_TRUE(trees.stages[k].stumps.empty());
+    EXPECT_EQ(std::size_t(report.stages[k].weak), trees.treeStages[k].size());
+    for (const Tree& t : trees.treeStages[k]) deeper += t.nodes.size() > 1;
+  }
+  EXPECT_GT(deeper, 0u);
+  const std::string one = modelToText(trees);
+  EXPECT_NE(one.find("\"version\": 5"), std::string::npos);
+  c.threads = 2;
+  EXPECT_EQ(modelToText(trainCascade(c, items, quiet)), one) << "two threads";
+  c.incrementalMining = false;
+  EXPECT_EQ(modelToText(trainCascade(c, items, quiet)), one) << "full rescan for negatives";
+  // Its own training positives pass at least the stages' hit rate.
+  const TrainingStacks stacks(items, c.pool.layers, trees.referenceHue, c.samples);
+  std::size_t accepted = 0;
+  for (const Sample& s : stacks.positives()) accepted += evaluateWindow(trees, stacks.integrals(s.stack), s.window).accepted;
+  EXPECT_GE(double(accepted), 0.95 * double(stacks.positives().size()));
+  // Depth 1: the stump trainer's model (the stump path is the default).
+  TrainingConfig d1 = twoLayerConfig();
+  const std::string stumps = modelToText(trainCascade(d1, items, quiet));
+  d1.stage.treeDepth = 1;
+  EXPECT_EQ(modelToText(trainCascade(d1, items, quiet)), stumps);
+  d1.stage.treeDepth = 9;
+  EXPECT_THROW(trainCascade(d1, items, quiet), std::invalid_argument);
+}
