@@ -114,6 +114,7 @@ int runEval(const EvalOptions& o) {
     j["positives"] = r.counts.positives;
     j["ignored_detections"] = r.counts.ignored;
     j["length"] = s.length;
+    j["split_nodes"] = s.splits;
     j["stages"] = s.stages;
     j["layer_weight_share"] = s.layerWeightShare;
     j["layer_stump_count"] = s.layerCount;
@@ -135,7 +136,8 @@ int runEval(const EvalOptions& o) {
               o.data.c_str(), o.split.c_str(), r.counts.stacks, match.minIou, match.minHeight, match.maxOcclusion,
               match.maxTruncation, match.minDetectionHeight, o.van.c_str());
   std::printf("| measure | value |\n|---|---:|\n");
-  std::printf("| length (stumps) | %zu |\n| stages | %zu |\n", s.length, s.stages);
+  std::printf("| length (weak classifiers) | %zu |\n| split nodes | %zu |\n| stages | %zu |\n", s.length, s.splits,
+              s.stages);
   std::printf("| recall | %s |\n| precision | %s |\n| F-measure | %s |\n| AP (40 recall points) | %s |\n",
               boosting::formatMeasure(r.counts.recall(), 3).c_str(), boosting::formatMeasure(r.counts.precision(), 3).c_str(),
               boosting::formatMeasure(r.counts.fMeasure(), 3).c_str(), boosting::formatMeasure(ap, 3).c_str());
@@ -143,7 +145,7 @@ int runEval(const EvalOptions& o) {
               r.counts.misses);
   std::printf("| positives | %zu |\n| ignored detections | %zu |\n", r.counts.positives, r.counts.ignored);
   std::printf("| corner features | %s |\n| ms per stack | %.1f |\n\n", pct(s.cornerShare()).c_str(), r.msPerStack);
-  std::printf("| layer | weight share | stumps |\n|---|---:|---:|\n");
+  std::printf("| layer | weight share | split nodes |\n|---|---:|---:|\n");
   for (const std::string& l : orderedLayers(s.layerWeightShare))
     std::printf("| %s | %s | %zu |\n", l.c_str(), pct(s.layerWeightShare.at(l)).c_str(),
                 s.layerCount.count(l) ? s.layerCount.at(l) : std::size_t{0});
