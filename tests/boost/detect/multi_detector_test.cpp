@@ -166,6 +166,25 @@ TEST(MultiDetector, ScalarFormEqualsVectorForms) {
 // models. Same accepted windows, same scores (bit for bit), same number of windows.
 namespace {
 
+// The documented scan windows of `c` on `s` (sizes from the base window by the scale factor at the
+// model's aspect ratio, position step = step x scale, both rounded half up), each evaluated alone
+// with evaluateWindow() on per-layer integrals: fn(box, result).
+template <class Fn>
+void forEachDocumentedWindow(const Cascade& c, const LayerStack& s, const ScanParams& p, Fn&& fn) {
+  auto half = [](double v) { return static_cast<int>(std::floor(v + 0.5)); };
+  const IntegralStack in = integrateFor(c, s);
+  for (double scale = 1.0;; scale *= p.scaleFactor) {
+    const int w = half(c.windowWidth * scale), h = half(c.windowHeight * scale);
+    if (w > s.width() || h > s.height()) break;
+    const int step = std::max(1, half(p.step * scale));
+    for (int y = 0; y + h <= s.height(); y += step)
+      for (int x = 0; x + w <= s.width(); x += step) {
+        const Box box{double(x), double(y), double(w), double(h)};
+        fn(box, evaluateWindow(c, in, box));
+      }
+  }
+}
+
 void expectOptimisedScanEqualsPlainPerWindowEvaluation(const std::vector<Cascade>& models, const char* kind) {
   const MultiDetector all(models);
   const fs::path root = kData / "kitti";
@@ -176,27 +195,17 @@ void expectOptimisedScanEqualsPlainPerWindowEvaluation(const std::vector<Cascade
   ScanParams p;
   p.scaleFactor = 1.1;
   p.step = 2;
-  auto half = [](double v) { return static_cast<int>(std::floor(v + 0.5)); };
   std::size_t accepted = 0, windows = 0, deep = 0;
   std::vector<std::vector<RawHit>> want(models.size());
   std::vector<std::size_t> count(models.size(), 0);
   for (std::size_t i = 0; i < models.size(); ++i) {
     const Cascade& c = models[i];
     ASSERT_EQ(c.minHeight, 0) << "the enumeration below starts at the base window";
-    const IntegralStack in = integrateFor(c, s);
-    for (double scale = 1.0;; scale *= p.scaleFactor) {
-      const int w = half(c.windowWidth * scale), h = half(c.windowHeight * scale);
-      if (w > s.width() || h > s.height()) break;
-      const int step = std::max(1, half(p.step * scale));
-      for (int y = 0; y + h <= s.height(); y += step)
-        for (int x = 0; x + w <= s.width(); x += step) {
-          const Box box{double(x), double(y), double(w), double(h)};
-          const WindowResult r = evaluateWindow(c, in, box);
-          ++count[i];
-          if (r.stagesPassed >= 3) ++deep;
-          if (r.accepted) want[i].push_back(RawHit{box, r.score, 0});
-        }
-    }
+    forEachDocumentedWindow(c, s, p, [&](const Box& box, const WindowResult& r) {
+      ++count[i];
+      if (r.stagesPassed >= 3) ++deep;
+      if (r.accepted) want[i].push_back(RawHit{box, r.score, 0});
+    });
     accepted += want[i].size();
     windows += count[i];
   }
@@ -690,25 +699,15 @@ TEST(MultiDetector, TreeCascadesDecideAsThePerWindowPathInEveryForm) {
   ScanParams p;
   p.scaleFactor = 1.25;
   p.step = 2;
-  auto half = [](double v) { return static_cast<int>(std::floor(v + 0.5)); };
   std::size_t accepted = 0, kittiAccepted = 0, deep = 0;
   for (const LayerStack& s : stacks) {
     const bool kitti = s.width() > 1000;
     // The plain definition for the tree model: every window of the documented enumeration.
     std::vector<RawHit> want;
-    const IntegralStack in = integrateFor(trees, s);
-    for (double scale = 1.0;; scale *= p.scaleFactor) {
-      const int w = half(trees.windowWidth * scale), h = half(trees.windowHeight * scale);
-      if (w > s.width() || h > s.height()) break;
-      const int step = std::max(1, half(p.step * scale));
-      for (int y = 0; y + h <= s.height(); y += step)
-        for (int x = 0; x + w <= s.width(); x += step) {
-          const Box box{double(x), double(y), double(w), double(h)};
-          const WindowResult r = evaluateWindow(trees, in, box);
-          deep += r.stagesPassed >= 2;
-          if (r.accepted) want.push_back(RawHit{box, r.score, 0});
-        }
-    }
+    forEachDocumentedWindow(trees, s, p, [&](const Box& box, const WindowResult& r) {
+      deep += r.stagesPassed >= 2;
+      if (r.accepted) want.push_back(RawHit{box, r.score, 0});
+    });
     (kitti ? kittiAccepted : accepted) += want.size();
     auto sameWindows = [&](const std::vector<RawHit>& got, const std::string& what) {
       ASSERT_EQ(got.size(), want.size()) << what;
