@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
+#include "feature_scaling.h"
 #include "fusedet/boost/laser_extent.h"
 
 namespace fusedet::boosting {
@@ -12,10 +14,6 @@ namespace fusedet::boosting {
 namespace {
 
 constexpr std::size_t kFeatures = 4 + 16 + 1 + 2 + 3 + 5;
-
-bool finite(std::span<const double> v) {
-  return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
-}
 
 }  // namespace
 
@@ -83,7 +81,7 @@ BoxRegression fitBoxRegression(const std::vector<std::vector<double>>& features,
   std::vector<std::size_t> rows;
   for (std::size_t i = 0; i < features.size(); ++i) {
     if (features[i].size() != dims) throw std::invalid_argument("fitBoxRegression: feature rows differ in length");
-    if (finite(features[i]) && finite(targets[i])) rows.push_back(i);
+    if (allFinite(features[i]) && allFinite(targets[i])) rows.push_back(i);
   }
   BoxRegression out;
   out.lambda = params.lambda;
@@ -101,16 +99,7 @@ BoxRegression fitBoxRegression(const std::vector<std::vector<double>>& features,
     for (Eigen::Index j = 0; j < d; ++j) X(i, j) = features[rows[static_cast<std::size_t>(i)]][static_cast<std::size_t>(j)];
     for (Eigen::Index t = 0; t < 4; ++t) Y(i, t) = targets[rows[static_cast<std::size_t>(i)]][static_cast<std::size_t>(t)];
   }
-  const Eigen::RowVectorXd mu = X.colwise().mean();
-  X.rowwise() -= mu;
-  Eigen::RowVectorXd sd = (X.colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt();
-  for (Eigen::Index j = 0; j < d; ++j) {
-    if (sd(j) < 1e-12) {  // constant over the samples: no information, weight 0
-      sd(j) = 1;
-      X.col(j).setZero();
-    }
-  }
-  X.array().rowwise() /= sd.array();
+  ColumnScaling scaling = standardiseColumns(X);  // a constant feature gets weight 0
   const Eigen::RowVectorXd ymu = Y.colwise().mean();
   Y.rowwise() -= ymu;
   // Centred data: the intercept is the targets' mean and is not penalised.
@@ -121,8 +110,8 @@ BoxRegression fitBoxRegression(const std::vector<std::vector<double>>& features,
     out.why = "the ridge system has no finite solution";
     return out;
   }
-  out.mean.assign(mu.data(), mu.data() + d);
-  out.scale.assign(sd.data(), sd.data() + d);
+  out.mean = std::move(scaling.mean);
+  out.scale = std::move(scaling.scale);
   out.weights.resize(dims);
   for (Eigen::Index j = 0; j < d; ++j)
     for (Eigen::Index t = 0; t < 4; ++t) out.weights[static_cast<std::size_t>(j)][static_cast<std::size_t>(t)] = Wt(j, t);

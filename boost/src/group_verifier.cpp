@@ -7,7 +7,9 @@
 #include <numeric>
 #include <opencv2/core.hpp>
 #include <stdexcept>
+#include <utility>
 
+#include "feature_scaling.h"
 #include "fusedet/boost/laser_cells.h"
 
 namespace fusedet::boosting {
@@ -48,10 +50,6 @@ double quantile(std::vector<float>& v, double q) {
   const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
   std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
   return v[k];
-}
-
-bool finite(std::span<const double> v) {
-  return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
 }
 
 }  // namespace
@@ -156,7 +154,7 @@ GroupVerifier fitGroupVerifier(const std::vector<std::vector<double>>& features,
   std::vector<std::size_t> rows;
   for (std::size_t i = 0; i < features.size(); ++i) {
     if (features[i].size() != dims) throw std::invalid_argument("fitGroupVerifier: feature rows differ in length");
-    if (finite(features[i])) rows.push_back(i);
+    if (allFinite(features[i])) rows.push_back(i);
   }
   GroupVerifier out;
   out.kind = params.kind;
@@ -198,19 +196,11 @@ GroupVerifier fitGroupVerifier(const std::vector<std::vector<double>>& features,
     for (Eigen::Index j = 0; j < d; ++j) X(i, j) = features[r][static_cast<std::size_t>(j)];
     y(i) = isHit[r] ? 1 : 0;
   }
-  const Eigen::RowVectorXd mu = X.leftCols(d).colwise().mean();
-  X.leftCols(d).rowwise() -= mu;
-  Eigen::RowVectorXd sd = (X.leftCols(d).colwise().squaredNorm() / static_cast<double>(n)).cwiseSqrt();
   std::vector<bool> used(dims, false);
   for (std::size_t j : featureSet(params.features))
     if (j < dims) used[j] = true;
   if (params.features == VerifierParams::Features::kAll) used.assign(dims, true);
-  for (Eigen::Index j = 0; j < d; ++j)
-    if (sd(j) < 1e-12 || !used[static_cast<std::size_t>(j)]) {  // constant (or left out): weight 0
-      sd(j) = 1;
-      X.col(j).setZero();
-    }
-  X.leftCols(d).array().rowwise() /= sd.array();
+  ColumnScaling scaling = standardiseColumns(X.leftCols(d), used);  // constant or left out: weight 0
   X.col(d).setOnes();  // intercept, not penalised
   Eigen::VectorXd penalty = Eigen::VectorXd::Constant(d + 1, params.lambda);
   penalty(d) = 0;
@@ -231,8 +221,8 @@ GroupVerifier fitGroupVerifier(const std::vector<std::vector<double>>& features,
     out.why = "the logistic fit has no finite solution";
     return out;
   }
-  out.mean.assign(mu.data(), mu.data() + d);
-  out.scale.assign(sd.data(), sd.data() + d);
+  out.mean = std::move(scaling.mean);
+  out.scale = std::move(scaling.scale);
   out.weights.assign(w.data(), w.data() + d);
   out.intercept = w(d);
   out.ready = true;
