@@ -39,10 +39,18 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
   if (groups) *groups = std::move(g);
 }
 
+void refineAndVerify(std::vector<Detection>& detections, const std::vector<std::vector<RawHit>>& hits,
+                     std::vector<std::vector<HitFate>>& fates, const LayerStack& stack, const DetectionSetup& setup) {
+  std::vector<GroupedBox> formed;  // what the verifier judges: each group before the box regression
+  refineBoxes(detections, hits, fates, stack, setup.laserExtent, setup.boxRegression,
+              setup.verifier.fitted() ? &formed : nullptr);
+  verifyGroups(detections, formed, fates, stack, setup.verifier);
+}
+
 namespace {
 
-// Scan, AND chain, group, then refineBoxes() with setup.boxRegression; `groups` (optional) gets
-// what formed each detection.
+// Scan, AND chain, group, then refineAndVerify(); `groups` (optional, only for a setup without a
+// verifier, whose detections match their groups one to one) gets what formed each detection.
 std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                        const DetectionSetup& setup, std::vector<GroupedBox>* groups,
                                        ScanStats* stats) {
@@ -68,13 +76,10 @@ std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain
     }
     dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);  // stretches alone
   }
-  if (setup.verifier.fitted()) {
-    std::vector<GroupedBox> formed;
-    refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, &formed);
-    verifyGroups(dets, formed, fates, stack, setup.verifier);
-    return dets;
-  }
-  refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);
+  if (groups)
+    refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);
+  else
+    refineAndVerify(dets, hits, fates, stack, setup);
   return dets;
 }
 
@@ -126,16 +131,15 @@ GroupVerifier fitGroupVerification(const std::vector<const Detector*>& chain, co
   std::vector<std::vector<double>> features;
   std::vector<bool> isHit;
   std::size_t positives = 0;
+  DetectionSetup unverified = setup;
+  unverified.verifier = {};
+  MatchConfig labelling = match;
+  if (params.labelIou > 0) labelling.minIou = params.labelIou;
   for (std::size_t i : indices) {
     const DatasetItem& item = items.at(i);
     std::vector<GroupedBox> groups;
-    std::vector<Detection> dets = detectChainGroups(chain, item.stack, setup, groups);
-    for (std::size_t d = 0; d < dets.size(); ++d) {  // the boxes the evaluation scores
-      dets[d].box = setup.boxRegression.refine(groups[d], item.stack);
-      dets[d].unitBox = item.stack.toUnit(dets[d].box);
-    }
-    MatchConfig labelling = match;
-    if (params.labelIou > 0) labelling.minIou = params.labelIou;
+    // The boxes the evaluation scores (with the box regression), each with its group before it.
+    const std::vector<Detection> dets = detectAndRefine(chain, item.stack, unverified, &groups, nullptr);
     const StackMatch m = matchDetections(dets, item.labels, labelling);
     positives += m.positives;
     for (std::size_t d = 0; d < dets.size(); ++d) {

@@ -104,11 +104,7 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
   const std::vector<std::vector<RawHit>> hits = scanModel(detector, stack, setup.scan);
   std::vector<std::vector<HitFate>> fates;
   out.detections = groupModelHits(cascade, hits, setup.group, stack, &fates);
-  // As detectChain(): boxes, then the verifier (which may drop groups and renumbers the fates).
-  std::vector<GroupedBox> formed;
-  refineBoxes(out.detections, hits, fates, stack, setup.laserExtent, setup.boxRegression,
-              setup.verifier.fitted() ? &formed : nullptr);
-  verifyGroups(out.detections, formed, fates, stack, setup.verifier);
+  refineAndVerify(out.detections, hits, fates, stack, setup);  // as detectChain()
   out.match = matchDetections(out.detections, labels, match);
 
   std::vector<std::map<std::tuple<double, double, double, double>, std::size_t>> hitAt(cascades.size());  // window -> raw hit

@@ -39,7 +39,7 @@ struct EvalOutcome {
 std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, const LayerStack& stack,
                                    const DetectionSetup& setup, ScanStats* stats = nullptr);
 
-// What follows grouping, the one rule detectChain() and the miss analysis share (detectPerClass(),
+// The box part of what follows grouping (refineAndVerify() below adds the verifier; detectPerClass(),
 // what fusedetd runs, applies the laser extent only: no model holds a fit, box_regression.h):
 // the laser extent (laser_extent.h), then `regression` (identity when not fitted) on grouped
 // detections. hits[k] / fates[k]: cascade k's raw hits and what became of them (grouping.h,
@@ -49,6 +49,11 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
                  const std::vector<std::vector<HitFate>>& fates, const LayerStack& stack,
                  const LaserExtentParams& extent, const BoxRegression& regression,
                  std::vector<GroupedBox>* groups = nullptr);
+// All that follows grouping, in detectChain()'s order, the one rule it and the miss analysis share:
+// refineBoxes() with setup's laser extent and box regression, then setup's verifier (verifyGroups():
+// may drop detections and renumbers `fates`; nothing when not fitted).
+void refineAndVerify(std::vector<Detection>& detections, const std::vector<std::vector<RawHit>>& hits,
+                     std::vector<std::vector<HitFate>>& fates, const LayerStack& stack, const DetectionSetup& setup);
 
 // Detections of the chain before `setup.boxRegression` and `setup.verifier`, each with what formed
 // it (box_regression.h).
