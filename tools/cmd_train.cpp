@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -55,6 +56,7 @@ struct TrainOptions {
   std::string softStartWeights = "margin";
   boosting::TrainingConfig::SideView sideView;  // off by default
   bool vanNegative = false;
+  std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -236,6 +238,21 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.negativesPerStage = o.negatives;
   c.seed = o.seed;
   c.threads = o.threads;
+  // --training-positives: the class rule of boost/class_rules.h decides the positives (labels
+  // mapped by trainingLabels() below), instead of --min-height / --max-occlusion alone.
+  std::optional<boosting::TrainingPositives> rule;
+  if (!o.trainingPositives.empty()) {
+    rule = boosting::parseTrainingPositives(o.trainingPositives);
+    if (o.validationPart > 0)
+      throw std::runtime_error("--training-positives: not with --validation-part (its held-back frames would be "
+                               "scored on the training labels)");
+    if (o.vanNegative) throw std::runtime_error("--training-positives: not with --van-negative");
+    const boosting::MatchConfig m =
+        boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), *rule);  // vans: car only
+    c.samples.minPositiveHeight = m.minHeight;
+    c.samples.maxOcclusion = m.maxOcclusion;
+    c.trainingPositives = boosting::toString(*rule);
+  }
   c.validate();
   if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
 
@@ -288,6 +305,11 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   for (std::size_t i = 0; i < trainIds.size(); ++i)
     items.push_back(shard.owns(i) ? readDatasetItem(o.data, trainIds[i], load)
                                   : readDatasetItemLabels(o.data, trainIds[i]));
+  if (rule) {
+    // Imported data sets do not say which labels carry tracking truncation levels: fractions.
+    const boosting::MatchConfig m = boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), *rule);
+    for (DatasetItem& item : items) item.labels = boosting::trainingLabels(item.labels, m);
+  }
   if (talk)
     std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -319,6 +341,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"stop_reason", report.stopReason},
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
+  if (rule) info.emplace_back("training_positives", c.trainingPositives);
   if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
   if (o.treeDepth > 1) info.emplace_back("weak_learner", "regression trees of depth " + std::to_string(o.treeDepth));
   if (c.sideView.minAspect > 0)
@@ -403,6 +426,18 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
           ->capture_default_str();
+      app.add_option("--training-positives", o->trainingPositives,
+                     "the class's training-positive rule (boost/class_rules.h) instead of --min-height / "
+                     "--max-occlusion (which check neither truncation nor the van rule): 'moderate' (the "
+                     "evaluation positives: height >= 25 px, occlusion <= 1, truncation <= 0.3) or 'hard' "
+                     "(occlusion <= 2, truncation <= 0.5), optionally followed by ',vans' (car: Van labels within "
+                     "the same limits train as cars) and ',min-height=N' (N px instead of 25), e.g. "
+                     "hard,vans,min-height=18. Other labels of the class (and vans) are ignored, never negatives; "
+                     "truncation is read as a fraction (an imported data set does not say which labels carry "
+                     "tracking levels). Written into the model file (\"training_positives\"). Not with "
+                     "--validation-part or --van-negative")
+          ->excludes("--min-height")
+          ->excludes("--max-occlusion");
       app.add_flag("--no-flip", o->noFlip, "do not add horizontally mirrored positives");
       app.add_option("--jitter", o->jitter,
                      "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "

@@ -71,6 +71,12 @@ struct TrainingConfig {
     double stageMaxFalseAlarm = 0;
     int jitterCopies = 0;
   } sideView;
+  // Which labels the caller made training positives before the items reached the trainer
+  // (class_rules.h: toString(TrainingPositives), labels mapped by trainingLabels() with
+  // trainingMatchConfig()); "" = moderate, the evaluation positives. The trainer does not apply it
+  // (it sees the mapped labels); it is part of the fold-model cache key (describeTrainingConfig(),
+  // only when set, so default keys stay as they were) and written into cached model files.
+  std::string trainingPositives;
   // The pool's values on every positive are evaluated once per training and kept (pool x
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.
