@@ -142,6 +142,23 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
   return cascade;
 }
 
+std::string fittedStepsName(const ChainSpec& spec) {
+  std::string name;
+  if (spec.boxFit) name = "box fit";
+  if (spec.verifier)
+    name += std::string(name.empty() ? "" : " + ") +
+            (spec.verifier->kind == VerifierParams::Kind::kHeightGate ? "gate" : "logistic verifier");
+  return name;
+}
+
+FoldFits countFits(const CrossValidationResult& result) {
+  FoldFits f;
+  f.trained = result.summaries.size();
+  for (const BoxRegression& b : result.boxFits) f.boxFits += b.fitted() ? 1 : 0;
+  for (const GroupVerifier& v : result.verifiers) f.verifiers += v.fitted() ? 1 : 0;
+  return f;
+}
+
 CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
                                     const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
                                     const MatchConfig& match, const DetectionSetup& setup,

@@ -100,8 +100,25 @@ struct ChainSpec {
   std::optional<VerifierParams> verifier{};
 };
 
+// The steps `spec` fits per fold after grouping, as reports and charts name the chain: "box fit",
+// "gate" (VerifierParams::Kind::kHeightGate) or "logistic verifier", joined by " + " in the order
+// they run; "" when it fits nothing (the cascades with the setup's grouping and laser extent).
+std::string fittedStepsName(const ChainSpec& spec);
+
+// Of a crossValidate() result's trained folds, how many fitted each step: a fit needs enough
+// training detections (BoxFitParams / VerifierParams::minSamples), an unfitted step is the
+// identity, so a point trained on few frames may run fewer steps than its name says.
+struct FoldFits {
+  std::size_t trained = 0;    // folds with a cascade
+  std::size_t boxFits = 0;    // of them with a fitted box refinement
+  std::size_t verifiers = 0;  // of them with a fitted verifier
+};
+FoldFits countFits(const CrossValidationResult& result);
+
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
-// fold's test items. `progress` gets a line per fold.
+// fold's test items. `progress` gets a line per fold. A learning-curve point is this run on the
+// point's folds (data_split.h learningCurveFold / learningPositivesFold): its box fit and verifier
+// are fitted per fold on that point's training items only.
 CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
                                     const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
                                     const MatchConfig& match, const DetectionSetup& setup,
