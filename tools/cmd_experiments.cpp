@@ -763,6 +763,7 @@ int runExperiments(ExperimentOptions o) {
     std::fflush(stdout);
   };
   std::map<std::string, std::map<std::string, std::vector<boosting::FrameOutcome>>> framesOf;  // class, config
+  std::map<std::string, boosting::FoldFits> allFits;  // class: the `all` run's fitted steps
 
   // Peer (person only): OpenCV's HOG people detector on every frame (it is not trained here).
   if (o.peers && std::find(o.classes.begin(), o.classes.end(), "person") != o.classes.end()) {
@@ -799,6 +800,9 @@ int runExperiments(ExperimentOptions o) {
   std::vector<std::size_t> learning;  // 0 ("all") = every training drive of the fold
   for (std::size_t k : preset.learningDrives) learning.push_back(k == 0 ? mostDrives : std::min(k, mostDrives));
   report.learningFolds = foldsText(learningFolds.size(), driveCount);
+  // The steps fitted after grouping are the same for every class and configuration (chainFor).
+  if (!o.classes.empty())
+    report.chain = boosting::fittedStepsName(chainFor(o, preset, o.classes.front(), "all", matchFor(o.classes.front())));
 
   // Training labels per class: positives by --training-positives (boost/class_rules.h), every
   // other label of the class an ignored label; the test frames keep their labels (evaluation).
@@ -850,7 +854,7 @@ int runExperiments(ExperimentOptions o) {
       if (!pr.empty())
         cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
                     lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
-      if (const cv::Mat chart = learningChart(cls, report.learning); !chart.empty())
+      if (const cv::Mat chart = learningChart(cls, report.learning, report.chain); !chart.empty())
         cv::imwrite((o.out / ("learning_" + cls + ".png")).string(), chart);
     }
     const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
@@ -948,6 +952,7 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
+    if (config == "all") allFits[cls] = boosting::countFits(cv);
     if ((config == "all" || config == "channels") && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
@@ -1029,6 +1034,7 @@ int runExperiments(ExperimentOptions o) {
       p.trainingCounts = m.trainingCounts;
       p.trainingF = m.trainingF;
       p.trainingAp = m.trainingAp;
+      p.fits = m.fits;
     } else {
       boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
       spec.scoreTrainingItems = preset.trainingScore;
@@ -1042,6 +1048,7 @@ int runExperiments(ExperimentOptions o) {
       for (std::size_t f = 0; headline && f < sub.size(); ++f) headline = sub[f].train == folds[f].train;
       if (headline) {
         frames = framesOf[cls]["all"];
+        p.fits = allFits[cls];
       } else {
         std::printf("%s / all, %s (learning curve, %s):\n", cls.c_str(), what.c_str(), report.learningFolds.c_str());
         const boosting::CrossValidationResult cv =
@@ -1049,6 +1056,7 @@ int runExperiments(ExperimentOptions o) {
         report.trainSeconds += cv.trainSeconds;
         foldModels.insert(cv.models.begin(), cv.models.end());
         frames = cv.frames;
+        p.fits = boosting::countFits(cv);
         if (spec.analyseMisses)
           report.misses.push_back({cls, "all, on its own training frames (" + report.learningFolds + ")",
                                    boosting::summariseMisses(cv.trainingPositives),
