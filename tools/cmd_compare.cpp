@@ -46,9 +46,13 @@ nlohmann::json countsJson(const boosting::Counts& c) {
   return {{"hits", c.hits}, {"false_alarms", c.falseAlarms}, {"misses", c.misses}, {"positives", c.positives}};
 }
 
-// "all", or "all:drives=8/all:drives=4" when B's configuration is another.
+// "all", or "all:drives=8/all:drives=4" when B's configuration is another; the protocol alike
+// ("3fold/lodo").
 std::string configLabel(const boosting::ComparisonRow& r) {
   return r.config == r.configB ? r.config : r.config + "/" + r.configB;
+}
+std::string protocolLabel(const boosting::ComparisonRow& r) {
+  return r.protocol == r.protocolB ? r.protocol : r.protocol + "/" + r.protocolB;
 }
 
 int runCompare(const CompareOptions& o) {
@@ -69,6 +73,7 @@ int runCompare(const CompareOptions& o) {
                            {"protocol", r.protocol},
                            {"config", r.config},
                            {"config_b", r.configB},
+                           {"protocol_b", r.protocolB},
                            {"frames", r.result.frames},
                            {"counts_a", countsJson(r.result.countsA)},
                            {"counts_b", countsJson(r.result.countsB)},
@@ -81,14 +86,18 @@ int runCompare(const CompareOptions& o) {
   std::printf("compare: A %s: %s\n", o.a.c_str(), a.command.c_str());
   std::printf("compare: B %s: %s\n", o.b.c_str(), b.command.c_str());
   int width = 11;  // the config column fits the longest label (learning-curve pairs are long)
-  for (const auto& r : rows) width = std::max(width, static_cast<int>(configLabel(r).size()));
-  std::printf("%-7s %-8s %-*s %6s %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %s\n", "class", "protocol", width, "config",
+  int pwidth = 8;   // the protocol column alike
+  for (const auto& r : rows) {
+    width = std::max(width, static_cast<int>(configLabel(r).size()));
+    pwidth = std::max(pwidth, static_cast<int>(protocolLabel(r).size()));
+  }
+  std::printf("%-7s %-*s %-*s %6s %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %s\n", "class", pwidth, "protocol", width, "config",
               "frames", "F_a", "F_b", "F_a-F_b", "[95 % CI]", "verdict", "AP_a", "AP_b", "AP_a-b", "[95 % CI]",
               "verdict", "hits/FA/misses a; b");
   for (const auto& r : rows) {
     const auto& c = r.result;
-    std::printf("%-7s %-8s %-*s %6zu %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %zu/%zu/%zu; %zu/%zu/%zu\n",
-                r.className.c_str(), r.protocol.c_str(), width, configLabel(r).c_str(), c.frames, fixed(c.f.a).c_str(),
+    std::printf("%-7s %-*s %-*s %6zu %6s %6s %7s %-18s %-12s %6s %6s %7s %-18s %-12s %zu/%zu/%zu; %zu/%zu/%zu\n",
+                r.className.c_str(), pwidth, protocolLabel(r).c_str(), width, configLabel(r).c_str(), c.frames, fixed(c.f.a).c_str(),
                 fixed(c.f.b).c_str(), fixed(c.f.difference, true).c_str(), interval(c.f.interval).c_str(),
                 c.f.verdict.c_str(), fixed(c.ap.a).c_str(), fixed(c.ap.b).c_str(),
                 fixed(c.ap.difference, true).c_str(), interval(c.ap.interval).c_str(), c.ap.verdict.c_str(),
@@ -98,7 +107,7 @@ int runCompare(const CompareOptions& o) {
   std::printf("compare: %zu rows, paired bootstrap over frames, %zu resamples, seed %llu, 95 %%\n", rows.size(),
               o.resamples, static_cast<unsigned long long>(o.seed));
   for (const auto& r : rows)
-    std::printf("compare: %s %s %s: F %s %s %s; AP %s %s %s\n", r.className.c_str(), r.protocol.c_str(),
+    std::printf("compare: %s %s %s: F %s %s %s; AP %s %s %s\n", r.className.c_str(), protocolLabel(r).c_str(),
                 configLabel(r).c_str(), fixed(r.result.f.difference, true).c_str(), interval(r.result.f.interval).c_str(),
                 r.result.f.verdict.c_str(), fixed(r.result.ap.difference, true).c_str(),
                 interval(r.result.ap.interval).c_str(), r.result.ap.verdict.c_str());
@@ -127,6 +136,11 @@ const bool registered = registerCommand(
                      "with --config: B's configuration to pair with A's, when it has another name - e.g. two "
                      "configurations or learning-curve points of one run: `fusedet compare RUN RUN --config "
                      "all:drives=8 --config-b all:drives=4`; the table's config column then reads A_CONFIG/B_CONFIG");
+      app.add_option("--protocol-b", o->filter.protocolB,
+                     "with --protocol: B's protocol to pair with A's - e.g. the learning curve's point on all "
+                     "training frames of 3 folds against the leave-one-drive-out run, the same frames with more "
+                     "training data per fold: `fusedet compare LODO 3F --protocol lodo --protocol-b 3fold --config "
+                     "all --config-b all:positives=all`; the table's protocol column then reads A/B");
       app.add_option("--bootstrap", o->resamples, "bootstrap resamples of the frames")
           ->check(CLI::Range(1, 1000000))
           ->capture_default_str();

@@ -137,13 +137,17 @@ std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& 
   if (!filter.configB.empty() && filter.config.empty())
     throw std::invalid_argument("a configuration of the second run (" + filter.configB +
                                 ") needs the first run's configuration to pair it with");
+  if (!filter.protocolB.empty() && filter.protocol.empty())
+    throw std::invalid_argument("a protocol of the second run (" + filter.protocolB +
+                                ") needs the first run's protocol to pair it with");
   std::vector<ComparisonRow> rows;
   for (const OutcomeSet& x : a.sets) {
     if (!passes(x)) continue;
     const std::string other = filter.configB.empty() ? x.config : filter.configB;
+    const std::string otherProtocol = filter.protocolB.empty() ? x.protocol : filter.protocolB;
     for (const OutcomeSet& y : b.sets)
-      if (y.className == x.className && y.protocol == x.protocol && y.config == other)
-        rows.push_back({x.className, x.protocol, x.config, other, compareSets(x, y, boot)});
+      if (y.className == x.className && y.protocol == otherProtocol && y.config == other)
+        rows.push_back({x.className, x.protocol, x.config, other, otherProtocol, compareSets(x, y, boot)});
   }
   if (rows.empty()) {
     const auto has = [&](const RunOutcomes& r) {
@@ -156,6 +160,7 @@ std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& 
     if (!filter.protocol.empty()) f += " protocol " + filter.protocol;
     if (!filter.config.empty()) f += " config " + filter.config;
     if (!filter.configB.empty()) f += " against config " + filter.configB;
+    if (!filter.protocolB.empty()) f += " against protocol " + filter.protocolB;
     throw ComparisonError("no class / protocol / configuration" + (f.empty() ? "" : " matching" + f) +
                           " is in both runs (first: " + has(a) + "; second: " + has(b) + ")");
   }

@@ -76,6 +76,20 @@ assert r["counts_b"] == {"hits": 1, "false_alarms": 1, "misses": 1, "positives":
 assert j["bootstrap"]["resamples"] == 200 and r["f_measure"]["interval"]["resamples"] == 200, j
 EOF
 
+# --protocol-b: a's lodo set against b's 3fold set of the same frames (e.g. the learning curve's
+# point on all training frames of 3 folds: less training data per fold).
+sed 's|"protocol": "lodo", "folds": 2|"protocol": "3fold", "folds": 3|' "$work/b.json" >"$work/b3.json"
+expect_error "no class / protocol / configuration matching protocol lodo is in both runs" \
+  "$work/a.json" "$work/b3.json" --protocol lodo
+"$fusedet" compare "$work/a.json" "$work/b3.json" --protocol lodo --protocol-b 3fold >"$work/ab3.txt" \
+  || fail "compare --protocol-b failed"
+cat "$work/ab3.txt"
+grep -qE '^car +lodo/3fold +all +2 +1\.000 +0\.500 +\+0\.500 \[\+0\.000, \+1\.000\] +not shown ' "$work/ab3.txt" \
+  || fail "table line of --protocol-b"
+grep -qE '^compare: car lodo/3fold all: F \+0\.500 ' "$work/ab3.txt" || fail "compare: line of --protocol-b"
+expect_error "a protocol of the second run (3fold) needs the first run's protocol to pair it with" \
+  "$work/a.json" "$work/b3.json" --protocol-b 3fold
+
 # Refusals: another IoU rule (--min-iou 0.5 against the devkit's 0.7), other frames, no common set,
 # truncated and missing files.
 write "$work/pascal.json" "${rule/0.7/0.5}" '[[2, 1]]' '[[1, 1]]'

@@ -171,21 +171,48 @@ TEST(PairedComparison, RunsPairTheirSetsAndFilter) {
   ASSERT_EQ(rows.size(), 2u);  // laser is only in a
   EXPECT_EQ(rows[0].className, "car");
   EXPECT_EQ(rows[1].className, "person");
-  EXPECT_EQ(compareRuns(a, b, {"person", "", "", ""}).size(), 1u);
-  EXPECT_EQ(compareRuns(a, b, {"", "lodo", "all", ""}).size(), 2u);
+  EXPECT_EQ(compareRuns(a, b, {"person", "", "", "", ""}).size(), 1u);
+  EXPECT_EQ(compareRuns(a, b, {"", "lodo", "all", "", ""}).size(), 2u);
   // Another configuration of b (e.g. a learning-curve point of the same run): a's laser against b's all.
-  const std::vector<ComparisonRow> cross = compareRuns(a, b, {"car", "", "laser", "all"});
+  const std::vector<ComparisonRow> cross = compareRuns(a, b, {"car", "", "laser", "all", ""});
   ASSERT_EQ(cross.size(), 1u);
   EXPECT_EQ(cross[0].config, "laser");
   EXPECT_EQ(cross[0].configB, "all");
   EXPECT_EQ(rows[0].configB, "all");
-  EXPECT_THROW(compareRuns(a, b, {"car", "", "", "all"}), std::invalid_argument);
-  const std::string none = errorOf([&] { compareRuns(a, b, {"", "3fold", "", ""}); });
+  EXPECT_THROW(compareRuns(a, b, {"car", "", "", "all", ""}), std::invalid_argument);
+  const std::string none = errorOf([&] { compareRuns(a, b, {"", "3fold", "", "", ""}); });
   EXPECT_NE(none.find("no class / protocol / configuration matching protocol 3fold is in both runs (first: car / "
                       "lodo / all, car / lodo / laser, person / lodo / all; second: person / lodo / all, car / lodo / "
                       "all)"),
             std::string::npos)
       << none;
+}
+
+// --protocol-b: a set of one fold design against b's of another on the same frames (a learning
+// curve's 3-fold point against leave-one-drive-out), with the difference worked by hand.
+TEST(PairedComparison, RunsPairAnotherProtocolOfTheSameFrames) {
+  RunOutcomes lodo, three;
+  lodo.sets = {set("all", {frame(1, {{2, true}}), frame(1, {{1, true}})})};
+  OutcomeSet s = set("all:positives=all", {frame(1, {{2, false}}), frame(1, {{1, true}})});
+  s.protocol = "3fold";
+  s.folds = 3;
+  three.sets = {s, set("all", {frame(1, {}), frame(1, {})})};  // a lodo set too: not the one asked for
+  const std::vector<ComparisonRow> rows = compareRuns(lodo, three, {"car", "lodo", "all", "all:positives=all", "3fold"});
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].protocol, "lodo");
+  EXPECT_EQ(rows[0].protocolB, "3fold");
+  EXPECT_EQ(rows[0].configB, "all:positives=all");
+  EXPECT_DOUBLE_EQ(*rows[0].result.f.a, 1.0);
+  EXPECT_DOUBLE_EQ(*rows[0].result.f.b, 0.5);  // 1 hit, 1 false alarm, 1 miss: 2 / (2 + 2)
+  EXPECT_DOUBLE_EQ(*rows[0].result.f.difference, 0.5);
+  // Without it the same filter pairs a's lodo set with b's lodo set of that name (there is none).
+  const std::vector<ComparisonRow> same = compareRuns(lodo, three, {"car", "lodo", "all", "", ""});
+  ASSERT_EQ(same.size(), 1u);
+  EXPECT_EQ(same[0].protocolB, "lodo");
+  EXPECT_DOUBLE_EQ(*same[0].result.f.b, 0.0);
+  EXPECT_THROW(compareRuns(lodo, three, {"car", "", "all", "", "3fold"}), std::invalid_argument);
+  const std::string none = errorOf([&] { compareRuns(lodo, three, {"car", "lodo", "laser", "", "3fold"}); });
+  EXPECT_NE(none.find("matching class car protocol lodo config laser against protocol 3fold"), std::string::npos) << none;
 }
 
 TEST(OutcomesFile, RoundTripsExactly) {

@@ -48,16 +48,21 @@ PairedComparison compareSets(const OutcomeSet& a, const OutcomeSet& b, const Boo
 
 // Which sets to compare; empty = any. configB (needs config): b's configuration paired with a's
 // `config` instead of the same name, e.g. a learning-curve point against another of the same run.
+// protocolB (needs protocol) likewise: b's fold design paired with a's `protocol`, e.g. the
+// learning curve's point on all training frames of 3 folds against the leave-one-drive-out run
+// (more training data per fold) - the frames must still be the same (compareSets()).
 struct ComparisonFilter {
-  std::string className, protocol, config, configB;
+  std::string className, protocol, config, configB, protocolB;
 };
 struct ComparisonRow {
   std::string className, protocol, config, configB;  // configB = config unless the filter names another
+  std::string protocolB;                             // = protocol unless the filter names another
   PairedComparison result;
 };
 // Every (class, protocol, configuration) present in both runs and passing the filter (b's
-// configuration = filter.configB when given), in a's order. Refuses (ComparisonError) when no set
-// pairs up, listing what each run has, and configB without config (std::invalid_argument).
+// configuration = filter.configB, its protocol = filter.protocolB when given), in a's order.
+// Refuses (ComparisonError) when no set pairs up, listing what each run has, and configB without
+// config or protocolB without protocol (std::invalid_argument).
 std::vector<ComparisonRow> compareRuns(const RunOutcomes& a, const RunOutcomes& b, const ComparisonFilter& filter,
                                        const BootstrapConfig& boot = {});
 
