@@ -57,6 +57,8 @@ struct TrainOptions {
   boosting::TrainingConfig::SideView sideView;  // off by default
   bool vanNegative = false;
   std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
+  bool ignoredLabelsAsNegatives = false;
+  std::string referenceHue = "distinctive";
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -227,6 +229,12 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
   if (!o.vanNegative) c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
+  c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
+  try {
+    boosting::setReferenceHueRule(c, o.referenceHue);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(std::string("--reference-hue: ") + e.what());
+  }
   c.samples.scan.scaleFactor = o.scaleFactor;
   c.samples.scan.step = o.step;
   c.stage.minHit = o.minHit;
@@ -482,6 +490,14 @@ const bool registered = registerCommand(
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
                    "negative windows on them)");
+      app.add_flag("--ignored-labels-as-negatives", o->ignoredLabelsAsNegatives,
+                   "ablation: the negative-window rule before the fix - windows around small or occluded labels of "
+                   "the class, or larger than a DontCare region they hold, may be negatives; vans are background "
+                   "(the old rule knows no neighbouring class)");
+      app.add_option("--reference-hue", o->referenceHue,
+                     "reference hue of the hue_distance layer: 'distinctive' (the class's hue most over-represented in "
+                     "its positives), 'most-frequent' (the paper's rule) or DEG")
+          ->capture_default_str();
       app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
           ->capture_default_str();
       app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")

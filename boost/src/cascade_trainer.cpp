@@ -1,6 +1,7 @@
 #include "fusedet/boost/cascade_trainer.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -63,6 +64,8 @@ void TrainingConfig::validate() const {
   if (!(sideView.stageMaxFalseAlarm >= 0 && sideView.stageMaxFalseAlarm < 1))
     bad("side view: stage max false-alarm rate must be in [0, 1) (0 = the first cascade's)");
   if (sideView.jitterCopies < 0) bad("side view: jittered copies must be >= 0");
+  if (referenceHueRule == ReferenceHueRule::kFixed && !(fixedReferenceHue >= 0 && fixedReferenceHue < 360))
+    bad("fixed reference hue must be in [0, 360) degrees");
   if (sideView.minAspect > 0 && validation.part > 0) bad("a side-view cascade cannot be trained with a validation part");
   if (!(samples.minPositiveAspect >= 0)) bad("positives' minimum aspect must be >= 0");
   if (!(samples.windowAspect >= 0)) bad("window aspect must be >= 0 (0 = the positives' median)");
@@ -70,7 +73,19 @@ void TrainingConfig::validate() const {
   if (!(samples.scan.step > 0)) bad("scan step must be > 0");
 }
 
-double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples) {
+void setReferenceHueRule(TrainingConfig& c, const std::string& text) {
+  using Rule = TrainingConfig::ReferenceHueRule;
+  if (text == "distinctive") return void(c.referenceHueRule = Rule::kDistinctive);
+  if (text == "most-frequent") return void(c.referenceHueRule = Rule::kMostFrequent);
+  double deg = -1;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), deg);
+  if (ec != std::errc() || end != text.data() + text.size() || !(deg >= 0 && deg < 360))
+    throw std::invalid_argument("expected distinctive, most-frequent or degrees in [0, 360), got '" + text + "'");
+  c.referenceHueRule = Rule::kFixed;
+  c.fixedReferenceHue = deg;
+}
+
+double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, bool mostFrequent) {
   HueHistogram hist, background;
   for (const DatasetItem& item : items) {
     try {
@@ -81,7 +96,7 @@ double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConf
       throw std::runtime_error("reference hue: item " + item.id + ": " + e.what());
     }
   }
-  return hist.distinctiveHue(background);
+  return mostFrequent ? hist.referenceHue() : hist.distinctiveHue(background);
 }
 
 namespace {
@@ -200,9 +215,13 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
   const Shard shard = job ? Shard{job->rank(), job->size()} : Shard{};
   std::optional<double> refHue;
   const auto& layers = config.pool.layers;
-  if (std::find(layers.begin(), layers.end(), "hue_distance") != layers.end())
-    refHue = job ? shardedReferenceHue(train, config.samples, shard, *job)
-                 : classReferenceHue(train, config.samples);
+  if (std::find(layers.begin(), layers.end(), "hue_distance") != layers.end()) {
+    using Rule = TrainingConfig::ReferenceHueRule;
+    const bool mostFrequent = config.referenceHueRule == Rule::kMostFrequent;
+    if (config.referenceHueRule == Rule::kFixed) refHue = config.fixedReferenceHue;
+    else refHue = job ? shardedReferenceHue(train, config.samples, shard, *job, mostFrequent)
+                      : classReferenceHue(train, config.samples, mostFrequent);
+  }
   report.referenceHue = refHue;
 
   const std::vector<bool> normalised = config.pool.contrastFlags();

@@ -46,6 +46,10 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
   if (c.sideView.minAspect > 0)
     d << "side_view min_aspect " << c.sideView.minAspect << " window_aspect " << c.sideView.windowAspect
       << " stage_max_fa " << c.sideView.stageMaxFalseAlarm << " jitter " << c.sideView.jitterCopies << "\n";
+  if (c.samples.ignoredLabelsAsNegatives) d << "ignored_labels_as_negatives\n";  // only then: keys stay as they were
+  if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";  // likewise
+  if (c.referenceHueRule == TrainingConfig::ReferenceHueRule::kMostFrequent) d << "reference_hue most_frequent\n";
+  if (c.referenceHueRule == TrainingConfig::ReferenceHueRule::kFixed) d << "reference_hue " << c.fixedReferenceHue << "\n";
   if (c.samples.jitterCopies > 0)
     d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
       << c.samples.jitterSeed << "\n";

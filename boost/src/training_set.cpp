@@ -33,16 +33,16 @@ std::vector<std::string> neighbourClasses(const std::string& className) {
 }
 
 NegativeWindowTest::NegativeWindowTest(const Labels& labels, const SampleConfig& c)
-    : maxIgnoreCoverage_(c.maxIgnoreCoverage), maxNegativeIou_(c.maxNegativeIou) {
+    : maxIgnoreCoverage_(c.maxIgnoreCoverage), maxNegativeIou_(c.maxNegativeIou), oldRule_(c.ignoredLabelsAsNegatives) {
   for (const Label& l : labels) {
-    if (isIgnoredLabel(l, c)) ignored_.push_back(l.box);
+    if (oldRule_ ? l.ignore : isIgnoredLabel(l, c)) ignored_.push_back(l.box);
     else if (l.className == c.className) positives_.push_back(l.box);
   }
 }
 
 bool NegativeWindowTest::operator()(const Box& window) const {
   for (const Box& b : ignored_)
-    if (coverage(window, b) > maxIgnoreCoverage_ || coverage(b, window) > maxIgnoreCoverage_) return false;
+    if (coverage(window, b) > maxIgnoreCoverage_ || (!oldRule_ && coverage(b, window) > maxIgnoreCoverage_)) return false;
   for (const Box& b : positives_)
     if (iou(window, b) >= maxNegativeIou_) return false;
   return true;

@@ -44,6 +44,12 @@ struct SampleConfig {
   double maxNegativeIou = 0.3;
   double maxIgnoreCoverage = 0.5;
   std::vector<std::string> ignoreClasses;  // e.g. {"van"} for car: KITTI's neighbouring class
+  // The rule before the fix above (an ablation, off by default): only ignore regions count as
+  // ignored, and only when they cover more than maxIgnoreCoverage of the window (a window 2-3x
+  // larger than a DontCare box is a negative); every label of the class, positive or not, blocks
+  // windows with IoU >= maxNegativeIou (a window around a small car is a negative); ignoreClasses
+  // are not used (their labels are background).
+  bool ignoredLabelsAsNegatives = false;
   int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
   // Side-view (aspect) cascades (TrainingConfig::sideView): only labels with w/h >= minPositiveAspect
   // become positives (0 = every aspect); the class's other labels stay what they are for the
@@ -80,6 +86,7 @@ class NegativeWindowTest {
  private:
   std::vector<Box> ignored_, positives_;
   double maxIgnoreCoverage_ = 0.5, maxNegativeIou_ = 0.3;
+  bool oldRule_ = false;  // SampleConfig::ignoredLabelsAsNegatives
 };
 
 struct NegativeHarvest {
