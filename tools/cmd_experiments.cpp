@@ -118,7 +118,6 @@ struct ExperimentOptions {
   bool ignoredLabelsAsNegatives = false;   // SampleConfig::ignoredLabelsAsNegatives
   std::string referenceHue = "distinctive";  // distinctive | most-frequent | DEG (TrainingConfig::ReferenceHueRule)
   bool unmaskedHue = false;                // fusion::dropHueMask on every item, train and test
-  bool ignoreVansInTraining = false;       // SampleConfig::ignoreClasses = neighbourClasses (as `fusedet train`)
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
@@ -454,7 +453,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.samples.jitterCopies = o.jitter;
   c.samples.flipPositives = !o.noMirror;
   c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
-  if (o.ignoreVansInTraining) c.samples.ignoreClasses = boosting::neighbourClasses(cls);
   boosting::setReferenceHueRule(c, o.referenceHue);
   c.sideView = o.sideView;
   return c;
@@ -613,9 +611,6 @@ int runExperiments(ExperimentOptions o) {
       throw std::runtime_error(std::string("--reference-hue: ") + e.what());
     }
   }
-  if (o.ignoreVansInTraining && o.ignoredLabelsAsNegatives)
-    throw std::runtime_error("--ignore-vans-in-training contradicts --ignored-labels-as-negatives (the old rule knows "
-                             "no neighbouring class)");
   if (o.unmaskedHue && !o.modelsOut.empty())
     throw std::runtime_error("--unmasked-hue cannot write --models-out: those models would meet masked hue layers at "
                              "detection (the model does not record the ablation)");
@@ -784,8 +779,6 @@ int runExperiments(ExperimentOptions o) {
         "the rule before the fix: windows around ignored labels (small/occluded cars, largely covering DontCare) "
         "may be negatives";
   if (o.referenceHue != "distinctive") report.settings["reference hue (--reference-hue)"] = o.referenceHue;
-  if (o.ignoreVansInTraining)
-    report.settings["training negatives (--ignore-vans-in-training)"] = "no window holding most of a van (car)";
   if (o.unmaskedHue)
     report.settings["hue mask (--unmasked-hue)"] = "dropped: every pixel's hue counts, grey and dark ones too";
   if (o.treeDepth > 1)  // only then: reports of stump runs stay as they were
@@ -1487,10 +1480,6 @@ const bool registered = registerCommand(
                      "in its positives, default), 'most-frequent' (the paper's rule, used before) or DEG for every "
                      "class (ablations; part of the fold-model cache key)")
           ->capture_default_str();
-      app.add_flag("--ignore-vans-in-training", o->ignoreVansInTraining,
-                   "car: no training negative holds most of a van either (KITTI's neighbouring class), as `fusedet "
-                   "train` does for the bundled models; part of the fold-model cache key. Default here: vans are "
-                   "background in training (they stay ignored in the evaluation, --van)");
       app.add_flag("--unmasked-hue", o->unmaskedHue,
                    "ablation: drop the hue layer's mask on every frame (training and test), as imported before the "
                    "mask: grey and dark pixels' hue counts in hue_distance and the reference hue. No re-import "
