@@ -248,18 +248,18 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.threads = o.threads;
   // --training-positives: the class rule of boost/class_rules.h decides the positives (labels
   // mapped by trainingLabels() below), instead of --min-height / --max-occlusion alone.
-  std::optional<boosting::TrainingPositives> rule;
+  // Imported data sets do not say which labels carry tracking truncation levels: fractions.
+  std::optional<boosting::MatchConfig> trainingMatch;
   if (!o.trainingPositives.empty()) {
-    rule = boosting::parseTrainingPositives(o.trainingPositives);
+    const boosting::TrainingPositives rule = boosting::parseTrainingPositives(o.trainingPositives);
     if (o.validationPart > 0)
       throw std::runtime_error("--training-positives: not with --validation-part (its held-back frames would be "
                                "scored on the training labels)");
     if (o.vanNegative) throw std::runtime_error("--training-positives: not with --van-negative");
-    const boosting::MatchConfig m =
-        boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), *rule);  // vans: car only
-    c.samples.minPositiveHeight = m.minHeight;
-    c.samples.maxOcclusion = m.maxOcclusion;
-    c.trainingPositives = boosting::toString(*rule);
+    trainingMatch = boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), rule);  // vans: car only
+    c.samples.minPositiveHeight = trainingMatch->minHeight;
+    c.samples.maxOcclusion = trainingMatch->maxOcclusion;
+    c.trainingPositives = boosting::toString(rule);
   }
   c.validate();
   if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
@@ -313,11 +313,8 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   for (std::size_t i = 0; i < trainIds.size(); ++i)
     items.push_back(shard.owns(i) ? readDatasetItem(o.data, trainIds[i], load)
                                   : readDatasetItemLabels(o.data, trainIds[i]));
-  if (rule) {
-    // Imported data sets do not say which labels carry tracking truncation levels: fractions.
-    const boosting::MatchConfig m = boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), *rule);
-    for (DatasetItem& item : items) item.labels = boosting::trainingLabels(item.labels, m);
-  }
+  if (trainingMatch)
+    for (DatasetItem& item : items) item.labels = boosting::trainingLabels(item.labels, *trainingMatch);
   if (talk)
     std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -349,7 +346,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"stop_reason", report.stopReason},
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
-  if (rule) info.emplace_back("training_positives", c.trainingPositives);
+  if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
   if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
   if (o.treeDepth > 1) info.emplace_back("weak_learner", "regression trees of depth " + std::to_string(o.treeDepth));
   if (c.sideView.minAspect > 0)
