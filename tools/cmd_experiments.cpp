@@ -109,7 +109,6 @@ struct ExperimentOptions {
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
   bool softCascade = false;
-  int treeDepth = 1;  // weak learner: 1 = stumps, d = regression trees of depth d
   std::string softStartWeights = "margin";
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
   std::string trainingPositives = "moderate";      // boost/class_rules.h TrainingPositives (training only)
@@ -448,7 +447,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
   c.softCascade = o.softCascade;
-  c.stage.treeDepth = o.treeDepth;
   c.stage.marginStartWeights = o.softStartWeights == "margin";
   c.samples.jitterCopies = o.jitter;
   c.samples.flipPositives = !o.noMirror;
@@ -781,9 +779,6 @@ int runExperiments(ExperimentOptions o) {
   if (o.referenceHue != "distinctive") report.settings["reference hue (--reference-hue)"] = o.referenceHue;
   if (o.unmaskedHue)
     report.settings["hue mask (--unmasked-hue)"] = "dropped: every pixel's hue counts, grey and dark ones too";
-  if (o.treeDepth > 1)  // only then: reports of stump runs stay as they were
-    report.settings["weak learner (--tree-depth)"] =
-        "regression trees of depth " + std::to_string(o.treeDepth) + " (max stumps per stage = max trees per stage)";
   if (!o.classStages.empty()) {
     std::string kept;
     for (const auto& [cls, n] : o.classStages) kept += (kept.empty() ? "" : ", ") + cls + " " + std::to_string(n);
@@ -1434,12 +1429,6 @@ const bool registered = registerCommand(
       app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
                    "models store their smallest training positive's height as minimum detection height "
                    "(default: detection scans from the base window)");
-      app.add_option("--tree-depth", o->treeDepth,
-                     "weak learner, as `fusedet train --tree-depth`: 1 = regression stumps (default), d = regression "
-                     "trees of depth d (boost/regression_tree.h; --max-weak then bounds trees per stage); part of the "
-                     "fold-model cache key (stump models keep their keys)")
-          ->check(CLI::Range(1, 8))
-          ->capture_default_str();
       app.add_flag("--soft-cascade", o->softCascade,
                    "train soft cascades (as `fusedet train --soft-cascade`: every stage boosts on from the "
                    "cumulative score and thresholds it); part of the fold-model cache key. Default: hard cascades");

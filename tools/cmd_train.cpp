@@ -43,7 +43,6 @@ struct TrainOptions {
   int windowHeight = 24;
   double minHit = 0.995, maxFa = 0.5, targetFa = 1e-5;
   int stages = 20, rounds = 100;
-  int treeDepth = 1;
   std::size_t negatives = 0;
   double minHeight = 25;
   int maxOcclusion = 1;
@@ -240,7 +239,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.stage.minHit = o.minHit;
   c.stage.maxFalseAlarm = o.maxFa;
   c.stage.maxWeak = o.rounds;
-  c.stage.treeDepth = o.treeDepth;
   c.targetFalseAlarm = o.targetFa;
   c.maxStages = o.stages;
   c.negativesPerStage = o.negatives;
@@ -348,7 +346,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
   if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
   if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
-  if (o.treeDepth > 1) info.emplace_back("weak_learner", "regression trees of depth " + std::to_string(o.treeDepth));
   if (c.sideView.minAspect > 0)
     info.emplace_back("side_view", cascade.aspectCascades.empty()
                                        ? "none trained (too few positives with w/h >= " + std::to_string(o.sideView.minAspect) + ")"
@@ -363,14 +360,13 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
     info.emplace_back("kept_stages", std::to_string(report.keptStages) + " of " + std::to_string(report.stages.size()));
   }
   boosting::saveModel(cascade, out, info);
-  const char* weak = cascade.hasTrees() ? "trees" : "stumps";
-  std::printf("wrote %s: class %s, %zu stages, %zu %s, window %dx%d, training %.1f s\n", out.string().c_str(),
-              cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), weak, cascade.windowWidth,
+  std::printf("wrote %s: class %s, %zu stages, %zu stumps, window %dx%d, training %.1f s\n", out.string().c_str(),
+              cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), cascade.windowWidth,
               cascade.windowHeight, report.seconds);
   std::printf("stop: %s\n", report.stopReason.c_str());
   for (const boosting::Cascade& a : cascade.aspectCascades)
-    std::printf("side view: window %dx%d, %zu stages, %zu %s\n", a.windowWidth, a.windowHeight, a.stages.size(),
-                a.weakCount(), weak);
+    std::printf("side view: window %dx%d, %zu stages, %zu stumps\n", a.windowWidth, a.windowHeight, a.stages.size(),
+                a.weakCount());
   if (c.sideView.minAspect > 0 && cascade.aspectCascades.empty())
     std::printf("side view: none trained (too few positives with w/h >= %g)\n", c.sideView.minAspect);
   if (o.eval) evaluateHeldBack(o, cascade, testIds);
@@ -418,13 +414,7 @@ const bool registered = registerCommand(
                      "stop when the cascade accepts at most this share of the label-free windows")
           ->capture_default_str();
       app.add_option("--stages", o->stages, "stage limit")->capture_default_str();
-      app.add_option("--rounds", o->rounds, "boosting rounds (weak classifiers) per stage at most")->capture_default_str();
-      app.add_option("--tree-depth", o->treeDepth,
-                     "weak learner: 1 = regression stumps; d = regression trees of depth d (each node's split "
-                     "searched as a stump on its samples; Dollar et al.'s ACF detectors use depth 2). The model "
-                     "file records the trees (format version 5). Not with mpirun")
-          ->check(CLI::Range(1, 8))
-          ->capture_default_str();
+      app.add_option("--rounds", o->rounds, "boosting rounds (stumps) per stage at most")->capture_default_str();
       app.add_option("--negatives", o->negatives, "negatives per stage (0 = max(500, 2 x positives))")
           ->capture_default_str();
       app.add_option("--min-height", o->minHeight, "[px] smaller labels of the class are not used as positives")

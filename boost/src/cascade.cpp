@@ -89,6 +89,7 @@ void Cascade::validate() const {
     }
   }
   const bool trees = hasTrees();
+  if (trees && !isOpenCv()) fail("decision trees are only supported in imported OpenCV cascades");
   if (trees && treeStages.size() != stages.size())
     fail("tree cascade has " + std::to_string(treeStages.size()) + " tree stages for " + std::to_string(stages.size()) +
          " stages");

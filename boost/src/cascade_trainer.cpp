@@ -47,7 +47,6 @@ void TrainingConfig::validate() const {
   if (!(stage.minHit > 0 && stage.minHit <= 1)) bad("min_hit must be in (0, 1]");
   if (!(stage.maxFalseAlarm > 0 && stage.maxFalseAlarm < 1)) bad("max_fa must be in (0, 1)");
   if (stage.maxWeak < 1) bad("rounds per stage must be >= 1");
-  if (stage.treeDepth < 1 || stage.treeDepth > 8) bad("tree depth must be in [1, 8] (1 = stumps)");
   if (!(targetFalseAlarm > 0 && targetFalseAlarm < 1)) bad("target false-alarm rate must be in (0, 1)");
   if (maxStages < 1) bad("stage limit must be >= 1");
   if (samples.jitterCopies < 0) bad("jittered copies must be >= 0");
@@ -107,9 +106,6 @@ Cascade truncated(const Cascade& c, std::size_t stages) {
   int used = -1;
   for (const Stage& st : out.stages)
     for (const Stump& s : st.stumps) used = std::max(used, s.feature);
-  for (const auto& trees : out.treeStages)
-    for (const Tree& t : trees)
-      for (const TreeNode& n : t.nodes) used = std::max(used, n.feature);
   out.features.resize(static_cast<std::size_t>(used + 1));
   return out;
 }
@@ -197,9 +193,6 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
     throw std::invalid_argument("training config: a soft cascade needs in-process training (not sharded)");
   if (job && config.validation.part > 0)
     throw std::invalid_argument("training config: a validation part needs in-process training (not sharded)");
-  if (job && config.stage.treeDepth > 1)
-    throw std::invalid_argument("training config: tree weak learners (tree depth " + std::to_string(config.stage.treeDepth) +
-                                ") need in-process training (not sharded: sharded_stage.h searches stumps only)");
   // The validation part (validation_part.h) is neither trained on nor harvested for negatives.
   std::vector<DatasetItem> train, heldItems;
   {
@@ -282,9 +275,6 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
     progress.onProgress(e);
   }
 
-  // Progress lines name the weak learner (" stumps" as before, " trees of depth d").
-  const std::string weakName =
-      config.stage.treeDepth > 1 ? " trees of depth " + std::to_string(config.stage.treeDepth) : std::string(" stumps");
   NegativeMiner miner(stacks);
   std::optional<PositiveFeatures> positiveValues;  // built at the first stage
   std::map<std::size_t, int> cascadeIndex;  // pool feature -> Cascade::features index
@@ -423,29 +413,22 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
       tb = Clock::now();
       matrixSeconds = std::chrono::duration<double>(tb - tm).count();
       matrixBytes = matrix.bytes();
-      r = sc.treeDepth > 1 ? trainTreeStage(matrix, positives, raw, sc, onRound, heldPtr, start)
-                           : trainStage(matrix, positives, raw, sc, onRound, heldPtr, start);
+      r = trainStage(matrix, positives, raw, sc, onRound, heldPtr, start);
     }
 
     Stage st;
     st.threshold = r.threshold;
-    const auto featureIndex = [&](std::size_t poolFeature) {
-      auto it = cascadeIndex.find(poolFeature);
-      if (it == cascadeIndex.end()) it = cascadeIndex.emplace(poolFeature, cascade.addFeature(pool[poolFeature])).first;
-      return it->second;
-    };
-    for (const FittedStump& s : r.stumps) st.stumps.push_back(Stump{featureIndex(s.feature), double(s.threshold), s.left, s.right});
-    if (sc.treeDepth > 1) {
-      std::vector<Tree> trees;
-      for (const FittedTree& t : r.trees) trees.push_back(toCascadeTree(t, featureIndex));
-      cascade.treeStages.push_back(std::move(trees));
+    for (const FittedStump& s : r.stumps) {
+      auto it = cascadeIndex.find(s.feature);
+      if (it == cascadeIndex.end()) it = cascadeIndex.emplace(s.feature, cascade.addFeature(pool[s.feature])).first;
+      st.stumps.push_back(Stump{it->second, double(s.threshold), s.left, s.right});
     }
     const double kept = st.threshold;
     cascade.stages.push_back(std::move(st));
 
     StageReport sr;
     sr.stage = stage;
-    sr.weak = static_cast<int>(r.stumps.size() + r.trees.size());
+    sr.weak = static_cast<int>(r.stumps.size());
     sr.hitRate = r.hitRate;
     sr.validationPositives = heldOut.count;
     sr.threshold = kept;
@@ -468,7 +451,7 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
     ev.hitRate = r.hitRate;
     ev.falseAlarm = r.falseAlarm;
     ev.elapsedSeconds = elapsed();
-    ev.message = "stage " + std::to_string(stage) + ": " + std::to_string(sr.weak) + weakName + ", hit rate " +
+    ev.message = "stage " + std::to_string(stage) + ": " + std::to_string(sr.weak) + " stumps, hit rate " +
                  fixed(r.hitRate, 4) + ", false alarms " + fixed(r.falseAlarm, 4) +
                  (r.reachedFalseAlarm ? "" : " (round limit)") +
                  (sr.validationPositives ? ", threshold " + sig(sr.threshold) + " from " +
@@ -512,7 +495,7 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
   // "kept K" only when a validation part chose the stage count (the plain line is matched by tests).
   done.message = "stopped after " + std::to_string(report.stages.size()) + " stages" +
                  (heldItems.empty() ? std::string() : ", kept " + std::to_string(cascade.stages.size())) + " (" +
-                 std::to_string(cascade.weakCount()) + weakName + "): " + report.stopReason;
+                 std::to_string(cascade.weakCount()) + " stumps): " + report.stopReason;
   progress.onProgress(done);
   if (reportOut) *reportOut = report;
   if (cascade.stages.empty())

@@ -37,7 +37,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << c.maxStages << " negatives " << c.negativesPerStage << " min_negatives " << c.minNegatives
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   if (c.minHeightFromPositives) d << "min_height_from_positives\n";
-  if (c.stage.treeDepth > 1) d << "tree_depth " << c.stage.treeDepth << "\n";  // only then: stump keys stay as they were
   if (c.softCascade)  // only then: hard keys stay those of earlier caches
     d << "soft_cascade" << (c.stage.marginStartWeights ? "" : " uniform_start_weights") << "\n";
   // Only when set: keys of configurations without them stay as they were.

@@ -60,18 +60,12 @@ WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box
                                 std::to_string(c.layers.size()));
   if (!c.contrastNormalised.empty()) checkContrastNormalisation(c, in, "evaluateWindow");
   WindowResult r;
-  for (std::size_t s = 0; s < c.stages.size(); ++s) {
-    const Stage& st = c.stages[s];
+  for (const Stage& st : c.stages) {
     double sum = c.soft ? r.score : 0;  // soft cascade: the cumulative score so far
     for (const Stump& t : st.stumps) {
       const float v = featureValue(in, c.features[static_cast<std::size_t>(t.feature)], window);
       sum += v < static_cast<float>(t.threshold) ? t.left : t.right;
     }
-    if (c.hasTrees())  // tree weak learners: the leaf each tree's path ends in, tree by tree
-      for (const Tree& t : c.treeStages[s])
-        sum += treeLeaf(t, [&](std::size_t n) {
-          return featureValue(in, c.features[static_cast<std::size_t>(t.nodes[n].feature)], window);
-        });
     r.score = sum;
     if (sum < st.threshold) return r;
     ++r.stagesPassed;

@@ -35,9 +35,9 @@ std::vector<double> softStartWeights(std::span<const double> start, std::size_t 
 
 namespace {
 
-// The Gentle AdaBoost loop of boostStage() and trainTreeStage(). fit(weights, outputs) fits one
-// round's weak learner, writes f(x_i) of every sample to outputs and stores it in the result;
-// heldOutputs(result, outputs) gives the last stored learner's f on the held-out positives.
+// The Gentle AdaBoost loop of boostStage(). fit(weights, outputs) fits one round's stump, writes
+// f(x_i) of every sample to outputs and stores it in the result; heldOutputs(result, outputs)
+// gives the last stored stump's f on the held-out positives.
 template <class Fit, class HeldOutputs>
 StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOutputs&& heldOutputs,
                         const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
@@ -124,33 +124,6 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
         const FittedStump& s = result.stumps.back();
         heldOut->values(s.feature, heldValues);
         for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(heldValues[i]);
-      },
-      config, onRound, heldOut, startScores);
-}
-
-StageResult trainTreeStage(const FeatureMatrix& m, std::size_t positives, const FeatureValuesFn& rawValues,
-                           const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                           const HeldOutPositives* heldOut, std::span<const double> startScores) {
-  if (config.treeDepth < 1) throw std::invalid_argument("trainTreeStage: tree depth must be >= 1");
-  TreeSearchOptions search;
-  search.depth = config.treeDepth;
-  search.stump.threads = config.threads;
-  search.stump.refineTop = config.refineTop;
-  const std::size_t held = heldOut ? heldOut->count : 0;
-  return boostRounds(
-      m.samples(), positives,
-      [&](std::span<const float> weights, std::span<double> outputs, StageResult& result) {
-        result.trees.push_back(fitRegressionTree(m, positives, weights, rawValues, search, outputs));
-        RoundInfo info;
-        info.tree = &result.trees.back();
-        return info;
-      },
-      [&](const StageResult& result, std::span<double> out) {
-        // Each node's feature on every held-out positive, then each positive's path.
-        const FittedTree& t = result.trees.back();
-        std::vector<std::vector<float>> nodeValues(t.nodes.size(), std::vector<float>(held));
-        for (std::size_t k = 0; k < t.nodes.size(); ++k) heldOut->values(t.nodes[k].feature, nodeValues[k]);
-        for (std::size_t i = 0; i < held; ++i) out[i] = t([&](std::size_t k) { return nodeValues[k][i]; });
       },
       config, onRound, heldOut, startScores);
 }

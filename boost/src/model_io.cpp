@@ -68,6 +68,16 @@ class Reader {
   std::string source_;
 };
 
+// Format versions written only for options that were removed (they measured no gain across
+// drives, issue 29): their files are refused, never read as a model they are not.
+struct RemovedVersion {
+  int version;
+  const char* option;
+};
+constexpr RemovedVersion kRemovedVersions[] = {
+    {5, "tree weak learners"},
+};
+
 }  // namespace
 
 std::string modelToText(const Cascade& c, const ModelInfo& info) {
@@ -86,12 +96,9 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"format\": " << Json(kModelFormatName).dump() << ",\n";
   // Such a model must not load in a build that would ignore the field and decide differently;
   // every other model keeps its bytes.
-  // Version 1 unless a layer is contrast-normalised (2), the cascade is soft (3), it holds
-  // aspect cascades (4) or its weak classifiers are trees (5).
-  const bool trees = c.hasTrees() || std::any_of(c.aspectCascades.begin(), c.aspectCascades.end(),
-                                                 [](const Cascade& a) { return a.hasTrees(); });
-  o << "  \"version\": "
-    << (trees ? 5 : !c.aspectCascades.empty() ? 4 : c.soft ? 3 : normalised.empty() ? 1 : 2) << ",\n";
+  // Version 1 unless a layer is contrast-normalised (2), the cascade is soft (3) or it holds
+  // aspect cascades (4).
+  o << "  \"version\": " << (!c.aspectCascades.empty() ? 4 : c.soft ? 3 : normalised.empty() ? 1 : 2) << ",\n";
   o << "  \"class\": " << Json(c.className).dump() << ",\n";
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
@@ -104,36 +111,21 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
     for (const auto& [k, v] : info) t[k] = v;
     o << "  \"training\": " << t.dump() << ",\n";
   }
-  // A feature with its threshold and left/right (leaf values of a stump, children of a tree node).
-  auto split = [&c](int feature, double threshold, const Json& left, const Json& right) {
-    const Feature& f = c.features.at(static_cast<std::size_t>(feature));
-    Json j;
-    j["type"] = std::string(1, toLetter(f.type));
-    j["rect"] = {f.rect.x, f.rect.y, f.rect.w, f.rect.h};
-    j["layer"] = c.layers.at(static_cast<std::size_t>(f.layer));
-    j["threshold"] = threshold;
-    j["left"] = left;
-    j["right"] = right;
-    return j;
-  };
   o << "  \"stages\": [\n";
   for (std::size_t s = 0; s < c.stages.size(); ++s) {
     const Stage& st = c.stages[s];
-    if (c.hasTrees()) {  // one tree per line: its nodes, then its leaves
-      const std::vector<Tree>& ts = c.treeStages[s];
-      o << "    {\"threshold\":" << Json(st.threshold).dump() << ",\"trees\":[\n";
-      for (std::size_t k = 0; k < ts.size(); ++k) {
-        Json nodes = Json::array();
-        for (const TreeNode& n : ts[k].nodes) nodes.push_back(split(n.feature, n.threshold, n.left, n.right));
-        o << "      " << Json{{"nodes", nodes}, {"leaves", ts[k].leaves}}.dump() << (k + 1 < ts.size() ? ",\n" : "\n");
-      }
-    } else {
-      o << "    {\"threshold\":" << Json(st.threshold).dump() << ",\"stumps\":[\n";
-      for (std::size_t k = 0; k < st.stumps.size(); ++k) {
-        const Stump& sp = st.stumps[k];
-        o << "      " << split(sp.feature, sp.threshold, sp.left, sp.right).dump()
-          << (k + 1 < st.stumps.size() ? ",\n" : "\n");
-      }
+    o << "    {\"threshold\":" << Json(st.threshold).dump() << ",\"stumps\":[\n";
+    for (std::size_t k = 0; k < st.stumps.size(); ++k) {
+      const Stump& sp = st.stumps[k];
+      const Feature& f = c.features.at(static_cast<std::size_t>(sp.feature));
+      Json j;
+      j["type"] = std::string(1, toLetter(f.type));
+      j["rect"] = {f.rect.x, f.rect.y, f.rect.w, f.rect.h};
+      j["layer"] = c.layers.at(static_cast<std::size_t>(f.layer));
+      j["threshold"] = sp.threshold;
+      j["left"] = sp.left;
+      j["right"] = sp.right;
+      o << "      " << j.dump() << (k + 1 < st.stumps.size() ? ",\n" : "\n");
     }
     o << "    ]}" << (s + 1 < c.stages.size() ? ",\n" : "\n");
   }
@@ -166,6 +158,11 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   const std::string format = r.string(root, "", "format");
   if (format != kModelFormatName) r.fail("format", "'" + format + "' is not a fusedet cascade model");
   const int version = r.integer(root, "", "version", 1, 1 << 20);
+  for (const RemovedVersion& removed : kRemovedVersions)
+    if (version == removed.version)
+      r.fail("version", "model format version " + std::to_string(version) + " (" + removed.option +
+                            ") was removed in fusedet 0.1.0 (the option measured no gain across "
+                            "drives); retrain the model with `fusedet train`");
   if (version < 1 || version > kModelFormatVersion)
     r.fail("version", "unsupported version " + std::to_string(version) + " (this build reads 1 to " +
                           std::to_string(kModelFormatVersion) + ")");
@@ -214,91 +211,52 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   if (root.contains("min_height")) c.minHeight = r.integer(root, "", "min_height", 0, 1 << 16);
   const Json& stages = r.array(root, "", "stages");
   if (stages.empty()) r.fail("stages", "no stages");
-  std::vector<std::pair<Feature, int>> seen;  // features in first-use order (shared by stumps and tree nodes)
-  // The feature of a stump or tree node at `kp` (type, rect, layer): its index in c.features.
-  auto featureAt = [&](const Json& j, const std::string& kp) {
-    Feature f;
-    const std::string type = r.string(j, kp, "type");
-    const auto t = type.size() == 1 ? featureTypeFromLetter(type[0]) : std::nullopt;
-    if (!t) r.fail(Reader::join(kp, "type"), "unknown feature type '" + type + "' (expected a-j)");
-    f.type = *t;
-    const Json& rect = r.array(j, kp, "rect");
-    if (rect.size() != 4) r.fail(Reader::join(kp, "rect"), "expected [x, y, w, h]");
-    double v[4];
-    for (std::size_t q = 0; q < 4; ++q) {
-      if (!rect[q].is_number() || !std::isfinite(rect[q].get<double>()))
-        r.fail(Reader::at(Reader::join(kp, "rect"), q), "expected a finite number");
-      v[q] = rect[q].get<double>();
-    }
-    f.rect = Box{v[0], v[1], v[2], v[3]};
-    const std::string layer = r.string(j, kp, "layer");
-    const auto li = std::find(c.layers.begin(), c.layers.end(), layer);
-    if (li == c.layers.end()) r.fail(Reader::join(kp, "layer"), "layer '" + layer + "' is not in \"layers\"");
-    f.layer = static_cast<int>(li - c.layers.begin());
-    try {
-      validateFeature(f, c.layers.size());
-    } catch (const std::invalid_argument& e) {
-      r.fail(kp, e.what());
-    }
-    int index = -1;
-    for (const auto& [g, i] : seen)
-      if (g == f) index = i;
-    if (index < 0) {
-      index = c.addFeature(f);
-      seen.emplace_back(f, index);
-    }
-    return index;
-  };
-  // Tree weak classifiers (version 5): stages hold "trees" instead of "stumps".
-  const bool treeModel = stages[0].is_object() && stages[0].contains("trees") && !stages[0].contains("stumps");
-  if (treeModel && version < 5)
-    r.fail("stages[0].trees", "tree weak classifiers need format version 5, the file says " + std::to_string(version));
+  std::vector<std::pair<Feature, int>> seen;  // features in first-use order (shared by stumps)
   for (std::size_t s = 0; s < stages.size(); ++s) {
     const std::string sp = Reader::at("stages", s);
     Stage st;
     st.threshold = r.number(stages[s], sp, "threshold");
-    if (!treeModel) {
-      const Json& stumps = r.array(stages[s], sp, "stumps");
-      if (stumps.empty()) r.fail(Reader::join(sp, "stumps"), "empty stage");
-      for (std::size_t k = 0; k < stumps.size(); ++k) {
-        const std::string kp = Reader::at(Reader::join(sp, "stumps"), k);
-        Stump stump;
-        stump.feature = featureAt(stumps[k], kp);
-        stump.threshold = r.number(stumps[k], kp, "threshold");
-        stump.left = r.number(stumps[k], kp, "left");
-        stump.right = r.number(stumps[k], kp, "right");
-        st.stumps.push_back(stump);
+    const Json& stumps = r.array(stages[s], sp, "stumps");
+    if (stumps.empty()) r.fail(Reader::join(sp, "stumps"), "empty stage");
+    for (std::size_t k = 0; k < stumps.size(); ++k) {
+      const std::string kp = Reader::at(Reader::join(sp, "stumps"), k);
+      const Json& j = stumps[k];
+      Feature f;
+      const std::string type = r.string(j, kp, "type");
+      const auto t = type.size() == 1 ? featureTypeFromLetter(type[0]) : std::nullopt;
+      if (!t) r.fail(Reader::join(kp, "type"), "unknown feature type '" + type + "' (expected a-j)");
+      f.type = *t;
+      const Json& rect = r.array(j, kp, "rect");
+      if (rect.size() != 4) r.fail(Reader::join(kp, "rect"), "expected [x, y, w, h]");
+      double v[4];
+      for (std::size_t q = 0; q < 4; ++q) {
+        if (!rect[q].is_number() || !std::isfinite(rect[q].get<double>()))
+          r.fail(Reader::at(Reader::join(kp, "rect"), q), "expected a finite number");
+        v[q] = rect[q].get<double>();
       }
-    } else {
-      if (stages[s].contains("stumps")) r.fail(Reader::join(sp, "stumps"), "a tree model's stage holds trees only");
-      const Json& trees = r.array(stages[s], sp, "trees");
-      if (trees.empty()) r.fail(Reader::join(sp, "trees"), "empty stage");
-      std::vector<Tree> stageTrees;
-      for (std::size_t k = 0; k < trees.size(); ++k) {
-        const std::string kp = Reader::at(Reader::join(sp, "trees"), k);
-        const Json& nodes = r.array(trees[k], kp, "nodes");
-        const Json& leaves = r.array(trees[k], kp, "leaves");
-        // Bounded: a tree of depth d has 2^d - 1 nodes; 2^16 keeps a garbage file from costing memory.
-        if (nodes.empty() || nodes.size() > (1u << 16)) r.fail(Reader::join(kp, "nodes"), "expected 1 to 65536 nodes");
-        Tree t;
-        for (std::size_t q = 0; q < nodes.size(); ++q) {
-          const std::string np = Reader::at(Reader::join(kp, "nodes"), q);
-          TreeNode n;
-          n.feature = featureAt(nodes[q], np);
-          n.threshold = r.number(nodes[q], np, "threshold");
-          const int limit = static_cast<int>(nodes.size());
-          n.left = r.integer(nodes[q], np, "left", -limit, limit);
-          n.right = r.integer(nodes[q], np, "right", -limit, limit);
-          t.nodes.push_back(n);
-        }
-        for (std::size_t q = 0; q < leaves.size(); ++q) {
-          if (!leaves[q].is_number() || !std::isfinite(leaves[q].get<double>()))
-            r.fail(Reader::at(Reader::join(kp, "leaves"), q), "expected a finite number");
-          t.leaves.push_back(leaves[q].get<double>());
-        }
-        stageTrees.push_back(std::move(t));
+      f.rect = Box{v[0], v[1], v[2], v[3]};
+      const std::string layer = r.string(j, kp, "layer");
+      const auto li = std::find(c.layers.begin(), c.layers.end(), layer);
+      if (li == c.layers.end()) r.fail(Reader::join(kp, "layer"), "layer '" + layer + "' is not in \"layers\"");
+      f.layer = static_cast<int>(li - c.layers.begin());
+      try {
+        validateFeature(f, c.layers.size());
+      } catch (const std::invalid_argument& e) {
+        r.fail(kp, e.what());
       }
-      c.treeStages.push_back(std::move(stageTrees));
+      Stump stump;
+      stump.threshold = r.number(j, kp, "threshold");
+      stump.left = r.number(j, kp, "left");
+      stump.right = r.number(j, kp, "right");
+      int index = -1;
+      for (const auto& [g, i] : seen)
+        if (g == f) index = i;
+      if (index < 0) {
+        index = c.addFeature(f);
+        seen.emplace_back(f, index);
+      }
+      stump.feature = index;
+      st.stumps.push_back(stump);
     }
     c.stages.push_back(std::move(st));
   }

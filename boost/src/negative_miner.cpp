@@ -17,25 +17,11 @@ namespace {
 bool sameStage(const Cascade& a, const Cascade& b, std::size_t i) {
   const Stage &x = a.stages[i], &y = b.stages[i];
   if (x.threshold != y.threshold || x.stumps.size() != y.stumps.size()) return false;
-  auto sameFeature = [&](int f, int g) {
-    return a.features.at(static_cast<std::size_t>(f)) == b.features.at(static_cast<std::size_t>(g));
-  };
   for (std::size_t k = 0; k < x.stumps.size(); ++k) {
     const Stump &s = x.stumps[k], &t = y.stumps[k];
     if (s.threshold != t.threshold || s.left != t.left || s.right != t.right) return false;
-    if (!sameFeature(s.feature, t.feature)) return false;
-  }
-  if (a.hasTrees() != b.hasTrees()) return false;
-  if (!a.hasTrees()) return true;
-  const std::vector<Tree> &p = a.treeStages.at(i), &q = b.treeStages.at(i);
-  if (p.size() != q.size()) return false;
-  for (std::size_t k = 0; k < p.size(); ++k) {
-    if (p[k].leaves != q[k].leaves || p[k].nodes.size() != q[k].nodes.size()) return false;
-    for (std::size_t n = 0; n < p[k].nodes.size(); ++n) {
-      const TreeNode &u = p[k].nodes[n], &v = q[k].nodes[n];
-      if (u.threshold != v.threshold || u.left != v.left || u.right != v.right || !sameFeature(u.feature, v.feature))
-        return false;
-    }
+    if (!(a.features.at(static_cast<std::size_t>(s.feature)) == b.features.at(static_cast<std::size_t>(t.feature))))
+      return false;
   }
   return true;
 }
@@ -110,7 +96,6 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
     // Every label-free window: what the first harvest (no stage yet) takes as candidates.
     applied_ = cascade;
     applied_.stages.clear();
-    applied_.treeStages.clear();
     alive_.assign(n, {});
     score_.assign(n, {});
     windows_.assign(n, 0);
@@ -139,9 +124,6 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
   // Only the stages not applied yet, on the windows every earlier stage accepted.
   Cascade fresh = cascade;
   fresh.stages.erase(fresh.stages.begin(), fresh.stages.begin() + static_cast<std::ptrdiff_t>(applied_.stages.size()));
-  if (fresh.hasTrees())
-    fresh.treeStages.erase(fresh.treeStages.begin(),
-                           fresh.treeStages.begin() + static_cast<std::ptrdiff_t>(applied_.stages.size()));
   forEachStack(n, threads, [&](std::size_t s) {
     if (!mine(s)) return;
     const IntegralStack& in = stacks_.integrals(s);
@@ -180,7 +162,6 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
   });
   applied_.features = cascade.features;
   applied_.stages = cascade.stages;
-  applied_.treeStages = cascade.treeStages;
 }
 
 NegativeHarvest NegativeMiner::harvest(const Cascade& cascade, std::size_t wanted, std::uint64_t seed,

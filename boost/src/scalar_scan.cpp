@@ -42,49 +42,32 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
         sp.contrasts.push_back({l, {0, w, hs, hs + w}, double(w) * double(h)});
       }
     }
-    // One feature laid out for this scale (leaf values set by the caller).
-    auto layOut = [&](int feature, double threshold) {
-      const Feature& f = c.features[static_cast<std::size_t>(feature)];
-      const auto l = static_cast<std::size_t>(f.layer);
-      const std::ptrdiff_t stride = in.layer(l).stride();
-      const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lwSize[l][0], lwSize[l][1]));
-      ScaledStump z;
-      z.layer = f.layer;
-      z.rest = lay.whiteIsRest ? 1.0 : 0.0;
-      z.blackArea = lay.blackArea;
-      z.whiteArea = lay.whiteArea;
-      auto corners = [stride](const PixelRect& r) {
-        return std::array<std::int32_t, 4>{
-            static_cast<std::int32_t>(r.y0 * stride + r.x0), static_cast<std::int32_t>(r.y0 * stride + r.x1),
-            static_cast<std::int32_t>(r.y1 * stride + r.x0), static_cast<std::int32_t>(r.y1 * stride + r.x1)};
-      };
-      z.ofs[0] = corners(lay.rects[0]);
-      z.ofs[1] = lay.blackCount == 2 ? corners(lay.rects[1]) : std::array<std::int32_t, 4>{0, 0, 0, 0};
-      z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
-      z.threshold = static_cast<float>(threshold);
-      z.normalised = c.isContrastNormalised(l);
-      return z;
-    };
-    sp.trees = c.hasTrees();
-    for (std::size_t s = 0; s < c.stages.size(); ++s) {
-      const Stage& st = c.stages[s];
-      ScaledStage ss{sp.trees ? sp.treeList.size() : sp.stumps.size(), 0, st.threshold};
+    for (const Stage& st : c.stages) {
+      ScaledStage ss{sp.stumps.size(), 0, st.threshold};
       for (const Stump& t : st.stumps) {
-        ScaledStump z = layOut(t.feature, t.threshold);
+        const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+        const auto l = static_cast<std::size_t>(f.layer);
+        const std::ptrdiff_t stride = in.layer(l).stride();
+        const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lwSize[l][0], lwSize[l][1]));
+        ScaledStump z;
+        z.layer = f.layer;
+        z.rest = lay.whiteIsRest ? 1.0 : 0.0;
+        z.blackArea = lay.blackArea;
+        z.whiteArea = lay.whiteArea;
+        auto corners = [stride](const PixelRect& r) {
+          return std::array<std::int32_t, 4>{
+              static_cast<std::int32_t>(r.y0 * stride + r.x0), static_cast<std::int32_t>(r.y0 * stride + r.x1),
+              static_cast<std::int32_t>(r.y1 * stride + r.x0), static_cast<std::int32_t>(r.y1 * stride + r.x1)};
+        };
+        z.ofs[0] = corners(lay.rects[0]);
+        z.ofs[1] = lay.blackCount == 2 ? corners(lay.rects[1]) : std::array<std::int32_t, 4>{0, 0, 0, 0};
+        z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
+        z.threshold = static_cast<float>(t.threshold);
         z.leaf = {t.left, t.right};
+        z.normalised = c.isContrastNormalised(l);
         sp.stumps.push_back(z);
       }
-      if (sp.trees)
-        for (const Tree& t : c.treeStages[s]) {
-          sp.treeList.push_back(ScaledTree{static_cast<std::uint32_t>(sp.stumps.size()),
-                                           static_cast<std::uint32_t>(sp.leaves.size())});
-          for (const TreeNode& node : t.nodes) {
-            sp.stumps.push_back(layOut(node.feature, node.threshold));
-            sp.children.push_back({node.left, node.right});
-          }
-          sp.leaves.insert(sp.leaves.end(), t.leaves.begin(), t.leaves.end());
-        }
-      ss.end = sp.trees ? sp.treeList.size() : sp.stumps.size();
+      ss.end = sp.stumps.size();
       sp.stages.push_back(ss);
     }
     plans.push_back(std::move(sp));

@@ -32,15 +32,8 @@ struct ScaledStump {
   bool normalised = false;       // divided by the window's contrast of its layer (feature.h)
 };
 
-// A tree weak learner (cascade.h's Tree) laid out for one scale: its nodes are ScaledStumps
-// (leaf unused) at [node0, node0 + nodes) of the stump array, their children (Tree's convention:
-// > 0 a node of the tree, <= 0 the leaf -child) and leaves at [leaf0, ...) of the plan's arrays.
-struct ScaledTree {
-  std::uint32_t node0 = 0, leaf0 = 0;
-};
-
 struct ScaledStage {
-  std::size_t begin = 0, end = 0;  // range in the stump array (in the tree array for tree cascades)
+  std::size_t begin = 0, end = 0;  // range in the stump array
   double threshold = 0;
 };
 
@@ -59,11 +52,6 @@ struct ScalePlan {
   std::vector<ScaledStump> stumps;
   std::vector<ScaledStage> stages;
   bool soft = false;  // Cascade::soft: stage sums start from the window's score so far
-  // Tree cascades (Cascade::treeStages): stages index `trees`; children per node of `stumps`.
-  bool trees = false;
-  std::vector<ScaledTree> treeList;
-  std::vector<std::array<int, 2>> children;
-  std::vector<double> leaves;
 };
 
 // Plans of every scale windowScales() gives for `c` on `in` (our models only).
@@ -83,41 +71,21 @@ inline void windowContrasts(const ScalePlan& sp, const double* const* base, cons
 // contrast: per layer, windowContrasts() of this window (read for normalised stumps only).
 // carried: a soft cascade's score after the stages before the plan's first (negative mining
 // applies only the stages a window has not passed yet); ignored by hard cascades.
-// One laid-out feature's value on the window, rounded to float as featureValue() rounds it.
-inline float scaledValue(const ScaledStump& z, const double* const* base, const double* contrast) {
-  const double* p = base[z.layer];
-  auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
-  const double black = rs(z.ofs[0]) + rs(z.ofs[1]);
-  const double white = rs(z.ofs[2]) - z.rest * black;
-  const double value = black / z.blackArea - white / z.whiteArea;
-  return static_cast<float>(z.normalised ? value / contrast[z.layer] : value);
-}
-
-// The leaf of tree t (treeLeaf()'s rule on the laid-out nodes).
-inline double scaledTreeLeaf(const ScalePlan& sp, const ScaledTree& t, const double* const* base,
-                             const double* contrast) {
-  std::uint32_t n = t.node0;
-  for (;;) {
-    const ScaledStump& z = sp.stumps[n];
-    const int child = sp.children[n][static_cast<std::size_t>(!(scaledValue(z, base, contrast) < z.threshold))];
-    if (child <= 0) return sp.leaves[t.leaf0 + static_cast<std::uint32_t>(-child)];
-    n = t.node0 + static_cast<std::uint32_t>(child);
-  }
-}
-
 inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, const double* contrast,
                               std::size_t& stumps, double carried = 0) {
   WindowResult r;
   r.score = carried;
   for (const ScaledStage& st : sp.stages) {
     double sum = sp.soft ? r.score : 0;
-    if (sp.trees) {
-      for (std::size_t k = st.begin; k < st.end; ++k) sum += scaledTreeLeaf(sp, sp.treeList[k], base, contrast);
-    } else {
-      for (std::size_t k = st.begin; k < st.end; ++k) {
-        const ScaledStump& z = sp.stumps[k];
-        sum += z.leaf[static_cast<std::size_t>(!(scaledValue(z, base, contrast) < z.threshold))];
-      }
+    for (std::size_t k = st.begin; k < st.end; ++k) {
+      const ScaledStump& z = sp.stumps[k];
+      const double* p = base[z.layer];
+      auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
+      const double black = rs(z.ofs[0]) + rs(z.ofs[1]);
+      const double white = rs(z.ofs[2]) - z.rest * black;
+      const double value = black / z.blackArea - white / z.whiteArea;
+      const auto v = static_cast<float>(z.normalised ? value / contrast[z.layer] : value);
+      sum += z.leaf[static_cast<std::size_t>(!(v < z.threshold))];
     }
     stumps += st.end - st.begin;
     r.score = sum;

@@ -22,51 +22,38 @@ namespace {
 constexpr int kBins = FeatureMatrix::kMaxBins;
 constexpr int kLanes = 4;  // independent sub-histograms: repeated bins do not serialise the adds
 
-// Which matrix column the i-th weight belongs to: every sample (AllSamples), or the samples of a
-// tree node (NodeSamples: sorted sample indices, weights given in their order).
-struct AllSamples {
-  std::size_t operator[](std::size_t i) const { return i; }
-};
-struct NodeSamples {
-  const std::uint32_t* index;
-  std::size_t operator[](std::size_t i) const { return index[i]; }
-};
-
-// Adds weights[i] into hist[i % 4][bins[at[i]]] for i in [begin, end).
-template <class At>
+// Adds weights[i] into hist[i % 4][bins[i]] for i in [begin, end).
 inline void accumulate(const std::uint8_t* bins, const float* w, std::size_t begin, std::size_t end,
-                       float (*hist)[kBins], At at) {
+                       float (*hist)[kBins]) {
   std::size_t i = begin;
   for (; i + 4 <= end; i += 4) {
-    hist[0][bins[at[i]]] += w[i];
-    hist[1][bins[at[i + 1]]] += w[i + 1];
-    hist[2][bins[at[i + 2]]] += w[i + 2];
-    hist[3][bins[at[i + 3]]] += w[i + 3];
+    hist[0][bins[i]] += w[i];
+    hist[1][bins[i + 1]] += w[i + 1];
+    hist[2][bins[i + 2]] += w[i + 2];
+    hist[3][bins[i + 3]] += w[i + 3];
   }
-  for (; i < end; ++i) hist[0][bins[at[i]]] += w[i];
+  for (; i < end; ++i) hist[0][bins[i]] += w[i];
 }
 
 // Two features in one pass: the weight is loaded once for both scatters (a quarter fewer
 // loads per entry than one feature at a time).
-template <class At>
 inline void accumulatePair(const std::uint8_t* b0, const std::uint8_t* b1, const float* w, std::size_t begin,
-                           std::size_t end, float (*h0)[kBins], float (*h1)[kBins], At at) {
+                           std::size_t end, float (*h0)[kBins], float (*h1)[kBins]) {
   std::size_t i = begin;
   for (; i + 4 <= end; i += 4) {
     const float w0 = w[i], w1 = w[i + 1], w2 = w[i + 2], w3 = w[i + 3];
-    const std::size_t a0 = at[i], a1 = at[i + 1], a2 = at[i + 2], a3 = at[i + 3];
-    h0[0][b0[a0]] += w0;
-    h1[0][b1[a0]] += w0;
-    h0[1][b0[a1]] += w1;
-    h1[1][b1[a1]] += w1;
-    h0[2][b0[a2]] += w2;
-    h1[2][b1[a2]] += w2;
-    h0[3][b0[a3]] += w3;
-    h1[3][b1[a3]] += w3;
+    h0[0][b0[i]] += w0;
+    h1[0][b1[i]] += w0;
+    h0[1][b0[i + 1]] += w1;
+    h1[1][b1[i + 1]] += w1;
+    h0[2][b0[i + 2]] += w2;
+    h1[2][b1[i + 2]] += w2;
+    h0[3][b0[i + 3]] += w3;
+    h1[3][b1[i + 3]] += w3;
   }
   for (; i < end; ++i) {
-    h0[0][b0[at[i]]] += w[i];
-    h1[0][b1[at[i]]] += w[i];
+    h0[0][b0[i]] += w[i];
+    h1[0][b1[i]] += w[i];
   }
 }
 
@@ -193,12 +180,14 @@ std::vector<std::size_t> refineOrder(const std::vector<SplitCandidate>& candidat
   return features;
 }
 
-namespace {
-
-// bestBinnedSplits() over n weights, the i-th of the matrix column at[i].
-template <class At>
-std::vector<SplitCandidate> binnedSplits(const FeatureMatrix& m, std::size_t n, std::size_t positives,
-                                         std::span<const float> weights, std::size_t k, int threads, At at) {
+std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t positives,
+                                             std::span<const float> weights, std::size_t k,
+                                             int threads) {
+  const std::size_t n = m.samples();
+  if (weights.size() != n || positives > n)
+    throw std::invalid_argument("bestBinnedSplits: " + std::to_string(weights.size()) +
+                                " weights / " + std::to_string(positives) + " positives for " +
+                                std::to_string(n) + " samples");
   k = std::max<std::size_t>(1, k);
   constexpr std::size_t kChunk = 256;
   const std::size_t chunks = (m.features() + kChunk - 1) / kChunk;
@@ -217,16 +206,16 @@ std::vector<SplitCandidate> binnedSplits(const FeatureMatrix& m, std::size_t n, 
                           std::size_t f = c * kChunk;
                           for (; f + 1 < end; f += 2) {
                             const std::uint8_t *b0 = m.row(f), *b1 = m.row(f + 1);
-                            accumulatePair(b0, b1, weights.data(), 0, positives, pos[0], pos[1], at);
-                            accumulatePair(b0, b1, weights.data(), positives, n, neg[0], neg[1], at);
+                            accumulatePair(b0, b1, weights.data(), 0, positives, pos[0], pos[1]);
+                            accumulatePair(b0, b1, weights.data(), positives, n, neg[0], neg[1]);
                             for (int q = 0; q < 2; ++q) {
                               const SplitCandidate s = scanBins(f + std::size_t(q), pos[q], neg[q]);
                               if (s.gain >= 0) keepBestSplits(top, s, k);
                             }
                           }
                           if (f < end) {
-                            accumulate(m.row(f), weights.data(), 0, positives, pos[0], at);
-                            accumulate(m.row(f), weights.data(), positives, n, neg[0], at);
+                            accumulate(m.row(f), weights.data(), 0, positives, pos[0]);
+                            accumulate(m.row(f), weights.data(), positives, n, neg[0]);
                             const SplitCandidate s = scanBins(f, pos[0], neg[0]);
                             if (s.gain >= 0) keepBestSplits(top, s, k);
                           }
@@ -238,33 +227,6 @@ std::vector<SplitCandidate> binnedSplits(const FeatureMatrix& m, std::size_t n, 
   for (const auto& chunk : perChunk)
     for (const SplitCandidate& s : chunk) keepBestSplits(top, s, k);
   return top;
-}
-
-}  // namespace
-
-std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t positives,
-                                             std::span<const float> weights, std::size_t k,
-                                             int threads) {
-  const std::size_t n = m.samples();
-  if (weights.size() != n || positives > n)
-    throw std::invalid_argument("bestBinnedSplits: " + std::to_string(weights.size()) +
-                                " weights / " + std::to_string(positives) + " positives for " +
-                                std::to_string(n) + " samples");
-  return binnedSplits(m, n, positives, weights, k, threads, AllSamples{});
-}
-
-std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::span<const std::uint32_t> samples,
-                                             std::size_t positives, std::span<const float> weights,
-                                             std::size_t k, int threads) {
-  if (weights.size() != samples.size() || positives > samples.size())
-    throw std::invalid_argument("bestBinnedSplits: " + std::to_string(weights.size()) + " weights / " +
-                                std::to_string(positives) + " positives for " + std::to_string(samples.size()) +
-                                " node samples");
-  for (std::size_t i = 0; i < samples.size(); ++i)
-    if (samples[i] >= m.samples() || (i > 0 && samples[i] <= samples[i - 1]))
-      throw std::invalid_argument("bestBinnedSplits: node samples must be increasing indices below " +
-                                  std::to_string(m.samples()));
-  return binnedSplits(m, samples.size(), positives, weights, k, threads, NodeSamples{samples.data()});
 }
 
 FittedStump fitStumpExact(std::size_t feature, std::span<const float> values,

@@ -79,15 +79,8 @@ struct GridContrast {
 constexpr int kSpanStride = 3;
 
 struct GridStage {
-  std::uint32_t begin = 0, end = 0;  // range in GridScale::stumps (in GridScale::trees for tree cascades)
+  std::uint32_t begin = 0, end = 0;
   double threshold = 0;
-};
-
-// A tree weak learner (cascade.h's Tree) laid out for one scale: its nodes are the GridStumps at
-// [node0, node0 + nodes) (their leaf values unused), their children (Tree's convention: > 0 a node
-// of the tree, <= 0 the leaf -child) in GridScale::children, its leaves at GridScale::leaves[leaf0...].
-struct GridTree {
-  std::uint32_t node0 = 0, leaf0 = 0;
 };
 
 struct GridScale {
@@ -105,11 +98,6 @@ struct GridScale {
   // lane is ever sure and every stump takes the exact fallback.
   double quickMarginRelative = kQuickMarginRelative;
   bool soft = false;  // Cascade::soft: a later stage's sum starts from the window's score so far
-  // Tree cascades (Cascade::treeStages): the stages index `trees`; `children` per node of `stumps`.
-  // The vector stage loops evaluate stumps only: tree cascades take the scalar form (scanTile).
-  std::vector<GridTree> trees;
-  std::vector<std::array<int, 2>> children;
-  std::vector<double> leaves;
 };
 
 // slots[l]: where layer l's sums live; sqSlots[l]: its squared sums (contrast-normalised layers).
@@ -170,58 +158,45 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     contrastOf[l] = static_cast<int>(sp.contrasts.size());
     sp.contrasts.push_back(k);
   }
-  // One feature laid out for this scale, as a stump with leaves left/right.
-  auto layOut = [&](int feature, double threshold, double left, double right) {
-    const Feature& f = c.features[static_cast<std::size_t>(feature)];
-    const SlotRef ref = slots[static_cast<std::size_t>(f.layer)];
-    const IntegralGrid& gr = in.grids()[static_cast<std::size_t>(ref.grid)];
-    const auto& lw = lwSize[static_cast<std::size_t>(ref.grid)];
-    const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lw[0], lw[1]));
-    const std::ptrdiff_t slot0 = ref.slot * gr.stride;
-    auto corners = [&](const PixelRect& r) {
-      return std::array<std::int32_t, 4>{static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x0),
-                                         static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x1),
-                                         static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x0),
-                                         static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x1)};
-    };
-    GridStump z;
-    z.grid = ref.grid;
-    z.intGrid = gr.exactInt;
-    z.checker = lay.blackCount == 2;
-    z.whiteIsRest = lay.whiteIsRest;
-    z.ofs[0] = corners(lay.rects[0]);
-    if (z.checker) z.ofs[1] = corners(lay.rects[1]);
-    z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
-    if (!z.checker && !z.whiteIsRest) {
-      if (z.ofs[2][0] == z.ofs[0][1] && z.ofs[2][2] == z.ofs[0][3]) z.shared = SharedEdge::kColumn;
-      if (z.ofs[2][0] == z.ofs[0][2] && z.ofs[2][1] == z.ofs[0][3]) z.shared = SharedEdge::kRow;
-    }
-    z.blackArea = lay.blackArea;
-    z.whiteArea = lay.whiteArea;
-    z.invBlackArea = 1.0 / lay.blackArea;
-    z.invWhiteArea = 1.0 / lay.whiteArea;
-    z.threshold = static_cast<float>(threshold);
-    z.cut = floatCut(z.threshold);
-    z.left = left;
-    z.right = right;
-    z.contrast = contrastOf[static_cast<std::size_t>(f.layer)];
-    return z;
-  };
-  const bool trees = c.hasTrees();
-  for (std::size_t s = 0; s < c.stages.size(); ++s) {
-    const Stage& st = c.stages[s];
-    GridStage gs{static_cast<std::uint32_t>(trees ? sp.trees.size() : sp.stumps.size()), 0, st.threshold};
-    for (const Stump& t : st.stumps) sp.stumps.push_back(layOut(t.feature, t.threshold, t.left, t.right));
-    if (trees)
-      for (const Tree& t : c.treeStages[s]) {
-        sp.trees.push_back(GridTree{static_cast<std::uint32_t>(sp.stumps.size()), static_cast<std::uint32_t>(sp.leaves.size())});
-        for (const TreeNode& node : t.nodes) {
-          sp.stumps.push_back(layOut(node.feature, node.threshold, 0, 0));
-          sp.children.push_back({node.left, node.right});
-        }
-        sp.leaves.insert(sp.leaves.end(), t.leaves.begin(), t.leaves.end());
+  for (const Stage& st : c.stages) {
+    GridStage gs{static_cast<std::uint32_t>(sp.stumps.size()), 0, st.threshold};
+    for (const Stump& t : st.stumps) {
+      const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+      const SlotRef ref = slots[static_cast<std::size_t>(f.layer)];
+      const IntegralGrid& gr = in.grids()[static_cast<std::size_t>(ref.grid)];
+      const auto& lw = lwSize[static_cast<std::size_t>(ref.grid)];
+      const FeatureLayout lay = layoutFeature(f.type, featureRectInWindow(f, lw[0], lw[1]));
+      const std::ptrdiff_t slot0 = ref.slot * gr.stride;
+      auto corners = [&](const PixelRect& r) {
+        return std::array<std::int32_t, 4>{static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x0),
+                                           static_cast<std::int32_t>(slot0 + r.y0 * gr.pitch + r.x1),
+                                           static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x0),
+                                           static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x1)};
+      };
+      GridStump z;
+      z.grid = ref.grid;
+      z.intGrid = gr.exactInt;
+      z.checker = lay.blackCount == 2;
+      z.whiteIsRest = lay.whiteIsRest;
+      z.ofs[0] = corners(lay.rects[0]);
+      if (z.checker) z.ofs[1] = corners(lay.rects[1]);
+      z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
+      if (!z.checker && !z.whiteIsRest) {
+        if (z.ofs[2][0] == z.ofs[0][1] && z.ofs[2][2] == z.ofs[0][3]) z.shared = SharedEdge::kColumn;
+        if (z.ofs[2][0] == z.ofs[0][2] && z.ofs[2][1] == z.ofs[0][3]) z.shared = SharedEdge::kRow;
       }
-    gs.end = static_cast<std::uint32_t>(trees ? sp.trees.size() : sp.stumps.size());
+      z.blackArea = lay.blackArea;
+      z.whiteArea = lay.whiteArea;
+      z.invBlackArea = 1.0 / lay.blackArea;
+      z.invWhiteArea = 1.0 / lay.whiteArea;
+      z.threshold = static_cast<float>(t.threshold);
+      z.cut = floatCut(z.threshold);
+      z.left = t.left;
+      z.right = t.right;
+      z.contrast = contrastOf[static_cast<std::size_t>(f.layer)];
+      sp.stumps.push_back(z);
+    }
+    gs.end = static_cast<std::uint32_t>(sp.stumps.size());
     sp.stages.push_back(gs);
   }
   sp.win = std::move(win);
@@ -303,42 +278,21 @@ void windowContrasts(const GridScale& sp, const void* const* grids, WindowList& 
   }
 }
 
-// One laid-out feature's value on window i of the list, rounded to float as featureValue() does.
-inline float gridValue(const GridStump& z, const void* const* grids, WindowList& l, std::size_t i) {
-  const std::int32_t o = l.offsets(static_cast<std::size_t>(z.grid))[i];
-  double value = z.intGrid ? stumpValue(z, static_cast<const std::int32_t*>(grids[z.grid]) + o)
-                           : stumpValue(z, static_cast<const double*>(grids[z.grid]) + o);
-  if (z.contrast >= 0) value = value / l.contrastOf(static_cast<std::size_t>(z.contrast))[i];
-  return static_cast<float>(value);
-}
-
-// The leaf of tree t on window i (treeLeaf()'s rule on the laid-out nodes).
-inline double gridTreeLeaf(const GridScale& sp, const GridTree& t, const void* const* grids, WindowList& l,
-                           std::size_t i) {
-  std::uint32_t n = t.node0;
-  for (;;) {
-    const GridStump& z = sp.stumps[n];
-    const int child = sp.children[n][static_cast<std::size_t>(!(gridValue(z, grids, l, i) < z.threshold))];
-    if (child <= 0) return sp.leaves[t.leaf0 + static_cast<std::uint32_t>(-child)];
-    n = t.node0 + static_cast<std::uint32_t>(child);
-  }
-}
-
 // One stage on windows [0, n) of the list, one window at a time; keeps those that pass.
 std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* const* grids, WindowList& l,
                         std::size_t n) {
   std::size_t kept = 0;
   const bool carry = sp.soft && &st != &sp.stages.front();  // stage 0 starts from 0 either way
-  const bool trees = !sp.trees.empty();
   for (std::size_t i = 0; i < n; ++i) {
     double sum = carry ? l.score[i] : 0;
-    if (trees) {
-      for (std::uint32_t k = st.begin; k < st.end; ++k) sum += gridTreeLeaf(sp, sp.trees[k], grids, l, i);
-    } else {
-      for (std::uint32_t k = st.begin; k < st.end; ++k) {
-        const GridStump& z = sp.stumps[k];
-        sum += gridValue(z, grids, l, i) < z.threshold ? z.left : z.right;
-      }
+    for (std::uint32_t k = st.begin; k < st.end; ++k) {
+      const GridStump& z = sp.stumps[k];
+      const std::int32_t o = l.offsets(static_cast<std::size_t>(z.grid))[i];
+      double value = z.intGrid ? stumpValue(z, static_cast<const std::int32_t*>(grids[z.grid]) + o)
+                               : stumpValue(z, static_cast<const double*>(grids[z.grid]) + o);
+      if (z.contrast >= 0) value = value / l.contrastOf(static_cast<std::size_t>(z.contrast))[i];
+      const auto v = static_cast<float>(value);
+      sum += v < z.threshold ? z.left : z.right;
     }
     if (!(sum < st.threshold)) l.keep(i, kept++, sum);
   }
@@ -581,8 +535,7 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
     l.reserve(windows, ng, nk);
   l.contrasts = nk;  // models of one scan differ; the buffer holds the most any had
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-  // Tree cascades: the scalar form (the vector stage loops evaluate stumps only), same decisions.
-  const int lanes = nk > kMaxVectorContrasts || !sp.trees.empty() ? 1 : vectorLanes(ng);
+  const int lanes = nk > kMaxVectorContrasts ? 1 : vectorLanes(ng);
 #else
   const int lanes = 1;
 #endif

@@ -12,9 +12,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "../train/synthetic_scenes.h"
 #include "fusedet/boost/aspect_cascades.h"
-#include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/fusion/kitti.h"
@@ -665,86 +663,4 @@ TEST(MultiDetector, StretchedWindowsDecideAsThePerWindowPathInEveryForm) {
     setVectorLanesLimit(8);
   }
   EXPECT_GT(stretchedHits, 0u) << "the car model should accept some stretched windows";
-}
-
-// Tree cascades (regression trees of depth 2 as weak learners, TrainingConfig's stage.treeDepth;
-// a model trained here on the synthetic scenes): every scanner - the per-class scalar path
-// (Detector::scan(IntegralStack), negative mining's), the one-pass scanner's scalar form and the
-// forms that would be vector ones (tree cascades take the scalar form explicitly) - accepts the
-// windows evaluateWindow() accepts, with its scores, on synthetic scenes and on a real KITTI stack
-// (there beside the bundled stump models in one pass, which keep their own vector path).
-TEST(MultiDetector, TreeCascadesDecideAsThePerWindowPathInEveryForm) {
-  TrainingConfig config = synthetic::twoLayerConfig();
-  config.stage.treeDepth = 2;
-  config.stage.maxFalseAlarm = 0.01;  // longer stages: several trees per stage
-  config.stage.maxWeak = 6;
-  config.maxStages = 3;
-  const std::vector<DatasetItem> items = synthetic::scenes(12, true);
-  NullProgress quiet;
-  Cascade trees = trainCascade(config, items, quiet);
-  // Stage thresholds lowered by 3/4 of a leaf's reach per tree (leaves lie in [-1, 1]): many windows
-  // pass deep into the cascade, so every tree decides on many windows of every scale.
-  for (std::size_t k = 0; k < trees.stages.size(); ++k)
-    trees.stages[k].threshold -= 0.75 * double(trees.treeStages[k].size());
-  ASSERT_TRUE(trees.hasTrees());
-  std::size_t deepTrees = 0;
-  for (const auto& stage : trees.treeStages)
-    for (const Tree& t : stage) deepTrees += t.nodes.size() > 1;
-  ASSERT_GT(deepTrees, 0u) << "the model needs trees that split more than once";
-  const std::vector<Cascade> models = {trees, bundledModels()[0]};
-  const MultiDetector all(models);
-  std::vector<LayerStack> stacks;
-  for (std::size_t i = 0; i < 3; ++i) stacks.push_back(items[i].stack);
-  stacks.push_back(kittiStacks().front());
-  ScanParams p;
-  p.scaleFactor = 1.25;
-  p.step = 2;
-  std::size_t accepted = 0, kittiAccepted = 0, deep = 0;
-  for (const LayerStack& s : stacks) {
-    const bool kitti = s.width() > 1000;
-    // The plain definition for the tree model: every window of the documented enumeration.
-    std::vector<RawHit> want;
-    forEachDocumentedWindow(trees, s, p, [&](const Box& box, const WindowResult& r) {
-      deep += r.stagesPassed >= 2;
-      if (r.accepted) want.push_back(RawHit{box, r.score, 0});
-    });
-    (kitti ? kittiAccepted : accepted) += want.size();
-    auto sameWindows = [&](const std::vector<RawHit>& got, const std::string& what) {
-      ASSERT_EQ(got.size(), want.size()) << what;
-      for (std::size_t k = 0; k < want.size(); ++k) {
-        EXPECT_EQ(got[k].box, want[k].box) << what << " hit " << k;
-        EXPECT_EQ(got[k].score, want[k].score) << what << " hit " << k;
-      }
-    };
-    ScanStats perClassStats, carStats;
-    sameWindows(perClass(trees, s, p, perClassStats), "per-class scalar path on " + s.source);
-    const std::vector<RawHit> car = kitti ? perClass(models[1], s, p, carStats) : std::vector<RawHit>{};
-    for (int threads : {1, 2}) {
-      p.threads = threads;
-      for (bool vector : {false, true}) {
-        setVectorScanEnabled(vector);
-        for (int lanes : {8, 4}) {
-          setVectorLanesLimit(lanes);
-          const std::string what = "one pass on " + s.source + (vector ? ", vector " + std::to_string(lanes) : ", scalar") +
-                                   ", " + std::to_string(threads) + " threads";
-          if (kitti) {
-            std::vector<ScanStats> st;
-            const auto got = all.scan(s, p, &st);
-            sameWindows(got[0], what);
-            expectSameHits(got[1], car, "car " + what);
-            EXPECT_EQ(st[0].stumps, perClassStats.stumps) << what << ": weak classifiers evaluated";
-          } else {
-            sameWindows(Detector(trees).scan(s, p), what);
-          }
-        }
-      }
-      setVectorScanEnabled(true);
-      setVectorLanesLimit(8);
-    }
-  }
-  std::printf("tree cascade (%zu trees, %zu of them deeper than a stump): %zu windows accepted on the synthetic scenes, "
-              "%zu on the KITTI stack, %zu past 2 stages; every scan path identical\n",
-              trees.weakCount(), deepTrees, accepted, kittiAccepted, deep);
-  EXPECT_GT(accepted, 3u) << "the comparison needs accepted windows";
-  EXPECT_GT(kittiAccepted, 50u) << "also on the real stack";
 }

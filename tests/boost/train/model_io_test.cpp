@@ -6,6 +6,8 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
+
 #include <unistd.h>
 
 #include "../random_edits.h"
@@ -106,6 +108,53 @@ TEST(ModelIo, SaveAndLoadFile) {
   } catch (const ModelError& e) {
     EXPECT_NE(std::string(e.what()).find("missing.json: cannot open (no such file)"), std::string::npos) << e.what();
   }
+}
+
+// Files of format versions whose options were removed (they measured no gain across drives) are
+// refused with the file, the version, the option and what to do - here as the removed code wrote them.
+TEST(ModelIo, RemovedFormatVersionsAreRefusedWithWhatToDo) {
+  struct Removed {
+    int version;
+    std::string option, text;
+  };
+  const std::string head = "{\n  \"format\": \"fusedet-cascade\",\n  \"version\": ";
+  const std::string body =
+      ",\n  \"class\": \"car\",\n  \"window\": {\"width\":40,\"height\":24},\n"
+      "  \"layers\": [\"intensity\",\"distance\"],\n  \"reference_hue\": null,\n";
+  const std::vector<Removed> removed = {
+      {5, "tree weak learners",
+       head + "5" + body +
+           "  \"stages\": [\n    {\"threshold\":-0.41,\"trees\":[\n      {\"nodes\":[{\"type\":\"g\",\"rect\":[0.25,0,0.5,0.5],"
+           "\"layer\":\"distance\",\"threshold\":0.12,\"left\":0,\"right\":-1}],\"leaves\":[-0.8,0.5]}\n    ]}\n  ]\n}\n"},
+  };
+  const auto dir = std::filesystem::temp_directory_path() / ("fusedet_model_removed_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const Removed& r : removed) {
+    const auto file = dir / ("v" + std::to_string(r.version) + ".json");
+    std::ofstream(file) << r.text;
+    try {
+      loadModel(file);
+      ADD_FAILURE() << "version " << r.version << " loaded";
+    } catch (const ModelError& e) {
+      const std::string want = file.string() + ": version: model format version " + std::to_string(r.version) + " (" +
+                               r.option + ") was removed in fusedet 0.1.0";
+      EXPECT_EQ(std::string(e.what()).rfind(want, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("retrain the model with `fusedet train`"), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+  // Nor can such a model be made in memory: trees belong to imported OpenCV cascades only.
+  Cascade trees = sample();
+  for (Stage& st : trees.stages) st.stumps.clear();
+  trees.treeStages.assign(2, {Tree{{TreeNode{0, 0.5, 0, -1}}, {-1, 1}}});
+  try {
+    trees.validate();
+    ADD_FAILURE() << "a tree model of ours validated";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("decision trees are only supported in imported OpenCV cascades"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(modelToText(trees), ModelError);
 }
 
 // The "training" pairs come back as written (the fold-model cache reads "train_seconds" from them);
@@ -216,7 +265,7 @@ TEST(ModelIo, BadContrastNormalisedFieldIsAClearError) {
                 .find("contrast_normalised[2]: layer 'intensity' listed twice"),
             std::string::npos);
   EXPECT_NE(with("{\"intensity\": true}").find("expected an array, got object"), std::string::npos);
-  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 6")).find("unsupported version 6 (this build reads 1 to 5)"),
+  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 6")).find("unsupported version 6 (this build reads 1 to 4)"),
             std::string::npos);
   // Invalid in memory: flags of the wrong size.
   c.contrastNormalised = {true};
@@ -409,91 +458,4 @@ TEST(ModelIo, FuzzedAspectCascadesNeverCrash) {
   ASSERT_NE(from, std::string::npos);
   // Edits only in the aspect cascades' part of the file.
   EXPECT_GT(fuzzSection(good, from, good.size(), 17, "{}[],:\"0-e9.ab4 ", [](const Cascade&) {}), 0);
-}
-
-namespace {
-
-// sample() with depth-2 trees instead of stumps (features shared between stages and nodes).
-Cascade treeSample() {
-  Cascade c = sample();
-  for (Stage& st : c.stages) st.stumps.clear();
-  // Stage 0: a full depth-2 tree and a tree whose root's right child is a leaf; stage 1: a stump-shaped tree.
-  c.treeStages.push_back({Tree{{TreeNode{0, 0.125, 1, 2}, TreeNode{1, -3.5, 0, -1}, TreeNode{1, 2.0, -2, -3}},
-                               {-0.8, 0.25, 0.5, 0.75}},
-                          Tree{{TreeNode{1, 0.5, 1, -2}, TreeNode{0, 1e-7, 0, -1}}, {-1, 0.5, 1}}});
-  c.treeStages.push_back({Tree{{TreeNode{1, 1e-7, 0, -1}}, {-1, 1}}});
-  return c;
-}
-
-}  // namespace
-
-TEST(ModelIo, TreeWeakClassifiersRoundTripAsVersion5) {
-  const Cascade c = treeSample();
-  ASSERT_NO_THROW(c.validate());
-  const std::string text = modelToText(c);
-  EXPECT_NE(text.find("\"version\": 5"), std::string::npos);
-  EXPECT_EQ(text.find("\"stumps\""), std::string::npos);
-  const Cascade back = modelFromText(text, "m.json");
-  ASSERT_TRUE(back.hasTrees());
-  ASSERT_EQ(back.treeStages.size(), 2u);
-  ASSERT_EQ(back.treeStages[0].size(), 2u);
-  const Tree& t = back.treeStages[0][0];
-  ASSERT_EQ(t.nodes.size(), 3u);
-  EXPECT_EQ(t.leaves, (std::vector<double>{-0.8, 0.25, 0.5, 0.75}));
-  EXPECT_EQ(t.nodes[1].threshold, -3.5);
-  EXPECT_EQ(t.nodes[0].left, 1);
-  EXPECT_EQ(t.nodes[1].right, -1);
-  EXPECT_EQ(back.features[std::size_t(t.nodes[0].feature)], c.features[0]);
-  EXPECT_EQ(back.features[std::size_t(t.nodes[2].feature)], c.features[1]);
-  EXPECT_EQ(back.features.size(), 2u) << "features shared by nodes stay shared";
-  EXPECT_EQ(back.weakCount(), 3u);
-  EXPECT_EQ(modelToText(back), text);  // stable
-  // Cut to one stage: the tree stages are cut alike.
-  EXPECT_EQ(firstStages(back, 1).treeStages.size(), 1u);
-  // The leaf each path ends in: node 0 value < 0.125 -> node 1; >= -3.5 -> leaf 1.
-  EXPECT_EQ(treeLeaf(t, [](std::size_t n) { return n == 0 ? 0.f : 0.f; }), 0.25);
-  EXPECT_EQ(treeLeaf(t, [](std::size_t n) { return n == 0 ? 1.f : 3.f; }), 0.75);
-  EXPECT_EQ(treeLeaf(t, [](std::size_t n) { return n == 0 ? 1.f : 1.f; }), 0.5);
-  EXPECT_EQ(treeLeaf(t, [](std::size_t n) { return n == 0 ? -1.f : -4.f; }), -0.8);
-}
-
-TEST(ModelIo, TreeErrorsNameThePlaceAndOlderVersionsAreRefused) {
-  const std::string good = modelToText(treeSample());
-  // An older build would not know trees: a file claiming an older version is refused.
-  EXPECT_NE(errorOf(replace(good, "\"version\": 5", "\"version\": 4"))
-                .find("m.json: stages[0].trees: tree weak classifiers need format version 5, the file says 4"),
-            std::string::npos);
-  std::string bad = replace(good, "\"threshold\":-3.5", "\"threshold\":\"x\"");
-  EXPECT_NE(errorOf(bad).find("m.json: stages[0].trees[0].nodes[1].threshold: expected a number, got string"),
-            std::string::npos)
-      << errorOf(bad);
-  // A child before its parent (a loop) or a leaf out of range: Cascade::validate's message.
-  bad = replace(good, "\"left\":0,\"right\":-1", "\"left\":1,\"right\":-1");
-  EXPECT_NE(errorOf(bad).find("node 1 has child 1 (must be a later node or a leaf)"), std::string::npos) << errorOf(bad);
-  bad = replace(good, "\"leaves\":[-0.8,0.25,0.5,0.75]", "\"leaves\":[-0.8,0.25,0.5]");
-  EXPECT_NE(errorOf(bad).find("tree needs nodes + 1 leaves"), std::string::npos) << errorOf(bad);
-  bad = replace(good, "\"leaves\":[-0.8", "\"leaves\":[\"a\"");
-  EXPECT_NE(errorOf(bad).find("stages[0].trees[0].leaves[0]: expected a finite number"), std::string::npos) << errorOf(bad);
-  EXPECT_NE(errorOf(replace(good, "\"trees\":[\n", "\"trees\":[],\"x\":[\n")).find("m.json"), std::string::npos);
-  // A stage mixing stumps into a tree model.
-  EXPECT_NE(errorOf(replace(good, "{\"threshold\":0.1,\"trees\"", "{\"threshold\":0.1,\"stumps\":[],\"trees\""))
-                .find("stages[1].stumps: a tree model's stage holds trees only"),
-            std::string::npos);
-  // In memory: a stage with both, tree stages of another count.
-  Cascade c = treeSample();
-  c.stages[0].stumps.push_back(Stump{0, 0.5, -1, 1});
-  EXPECT_THROW(c.validate(), std::invalid_argument);
-  c = treeSample();
-  c.treeStages.pop_back();
-  EXPECT_THROW(c.validate(), std::invalid_argument);
-}
-
-TEST(ModelIo, FuzzedTreesNeverCrash) {
-  const std::string good = modelToText(treeSample());
-  const std::size_t from = good.find("\"stages\"");
-  ASSERT_NE(from, std::string::npos);
-  // Edits only in the stages (nodes, children, leaves); every loaded copy is a valid tree cascade.
-  EXPECT_GT(fuzzSection(good, from, good.size(), 19, "{}[],:\"0-e9.-1trenodsleav ",
-                        [](const Cascade& back) { EXPECT_NO_THROW(back.validate()); }),
-            0);
 }

@@ -196,22 +196,3 @@ TEST(FeatureMatrix, BinsWithGivenEdgesCountTheEdgesBelow) {
   EXPECT_EQ(bins, (std::vector<int>{0, 1, 1, 2, 3, 3}));
   EXPECT_THROW(m.setFeature(0, values, std::vector<float>(256, 0.f)), std::out_of_range);
 }
-
-// Tree weak learners are searched in-process only (sharded_stage.h finds stumps): a sharded job
-// refuses them with a clear error on every rank instead of training stumps silently.
-TEST(ShardedTraining, TreeWeakLearnersAreRefusedClearly) {
-  const auto items = synthetic::scenes(4, true);
-  TrainingConfig config = shardedConfig();
-  config.stage.treeDepth = 2;
-  const auto errors = onRanks<std::string>(2, items, [&](const std::vector<DatasetItem>& mine, Collective& c) {
-    NullProgress quiet;
-    try {
-      trainCascade(config, mine, quiet, nullptr, &c);
-    } catch (const std::invalid_argument& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  });
-  for (const std::string& e : errors)
-    EXPECT_NE(e.find("tree weak learners (tree depth 2) need in-process training (not sharded"), std::string::npos) << e;
-}

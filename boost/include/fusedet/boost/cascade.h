@@ -44,13 +44,11 @@ struct Stump {
   double left = 0, right = 0;
 };
 
-// A regression tree as weak classifier: imported OpenCV cascades whose weak classifiers split more
-// than once (alt2, *_2splits, eye_tree_eyeglasses), and our models trained with tree weak learners
-// (TrainingConfig::treeDepth > 1, regression_tree.h). From node 0: value < threshold ? left :
-// right (compared in float, as stumps); a child > 0 is a node index (always greater than its
-// parent's), a child <= 0 is the leaf -child.
+// A decision tree, only in imported OpenCV cascades whose weak classifiers split more than once
+// (alt2, *_2splits, eye_tree_eyeglasses). From node 0: value < threshold ? left : right; a child
+// > 0 is a node index (always greater than its parent's), a child <= 0 is the leaf -child.
 struct TreeNode {
-  int feature = 0;  // index into Cascade::features (ours) or Cascade::haarFeatures (OpenCV)
+  int feature = 0;  // index into Cascade::haarFeatures
   double threshold = 0;
   int left = 0, right = 0;
 };
@@ -58,19 +56,6 @@ struct Tree {
   std::vector<TreeNode> nodes;
   std::vector<double> leaves;  // nodes.size() + 1
 };
-
-// The leaf a tree gives for the values of its nodes' features: value(node index) -> float, read
-// only for the nodes on the path (the one rule every evaluation path of our tree models follows).
-template <class NodeValue>
-double treeLeaf(const Tree& t, NodeValue&& value) {
-  int n = 0;
-  for (;;) {
-    const TreeNode& node = t.nodes[static_cast<std::size_t>(n)];
-    const int child = value(static_cast<std::size_t>(n)) < static_cast<float>(node.threshold) ? node.left : node.right;
-    if (child <= 0) return t.leaves[static_cast<std::size_t>(-child)];
-    n = child;
-  }
-}
 
 struct Stage {
   std::vector<Stump> stumps;
@@ -107,9 +92,8 @@ struct Cascade {
   // Soft cascade (above): stage sums are cumulative. Model files record it ("cascade": "soft");
   // OpenCV models are never soft.
   bool soft = false;
-  // Tree cascades (OpenCV tree cascades, our models trained with tree weak learners): the weak
-  // classifiers of stage i are treeStages[i] (instead of stages[i].stumps, which stay empty;
-  // stages[i].threshold applies). Empty for stump cascades.
+  // OpenCV tree cascades only: the weak classifiers of stage i are treeStages[i] (instead of
+  // stages[i].stumps, which stay empty; stages[i].threshold applies). Empty for every other model.
   std::vector<std::vector<Tree>> treeStages;
   // Further cascades of the same class, each trained for its own window aspect (e.g. cars seen
   // from the side, TrainingConfig::sideView) and scanned at it; their detections are merged with
@@ -132,9 +116,9 @@ struct Cascade {
   // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
   // index out of range, hue_distance without a reference hue, OpenCV model without one layer,
   // contrastNormalised not of the layers' size (or set on an OpenCV model), a soft OpenCV model,
-  // an aspect cascade of another class, an OpenCV one, or one holding aspect cascades itself, a
-  // tree stage count other than the stage count, a stage mixing stumps and trees, a tree whose
-  // children do not follow their parent.
+  // an aspect cascade of another class, an OpenCV one, or one holding aspect cascades itself, trees
+  // in one of our models, a tree stage count other than the stage count, a stage mixing stumps
+  // and trees, a tree whose children do not follow their parent.
   void validate() const;
 };
 

@@ -34,7 +34,7 @@ struct TrainingConfig {
   std::string className = "car";
   PoolConfig pool;        // layers, feature types, grid
   SampleConfig samples;   // className is taken from above
-  StageConfig stage;      // min_hit, max_fa, rounds per stage, weak learner (treeDepth: 1 = stumps, d = trees)
+  StageConfig stage;      // min_hit, max_fa, rounds per stage
   double targetFalseAlarm = 1e-5;     // of the label-free windows scanned
   int maxStages = 20;
   std::size_t negativesPerStage = 0;  // 0 = max(500, 2 x positives)
@@ -94,7 +94,7 @@ struct TrainingConfig {
 
 struct StageReport {
   int stage = 0;  // 1-based
-  int weak = 0;   // weak classifiers (stumps, or trees with StageConfig::treeDepth > 1)
+  int weak = 0;   // stumps
   double hitRate = 0, falseAlarm = 0;  // on this stage's training samples
   bool reachedFalseAlarm = false;      // false: stopped at the round limit
   std::size_t positives = 0, negatives = 0;

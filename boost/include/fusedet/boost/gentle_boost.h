@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "fusedet/boost/feature_matrix.h"
-#include "fusedet/boost/regression_tree.h"
 #include "fusedet/boost/stump.h"
 
 namespace fusedet::boosting {
@@ -26,22 +25,17 @@ struct StageConfig {
   // each class (true, the boosting chain) or uniform within each class as in a hard stage (false:
   // only the sums and the threshold carry the earlier stages' evidence).
   bool marginStartWeights = true;
-  // Weak learner: 1 = regression stumps (trainStage()), d > 1 = regression trees of depth d
-  // (trainTreeStage(), regression_tree.h).
-  int treeDepth = 1;
 };
 
 struct RoundInfo {
   int round = 0;  // 1-based
   double hitRate = 0, falseAlarm = 0;
   double threshold = 0;
-  FittedStump stump;  // feature = row of the matrix (stump stages)
-  const FittedTree* tree = nullptr;  // tree stages (trainTreeStage()): this round's tree
+  FittedStump stump;  // feature = row of the matrix
 };
 
 struct StageResult {
-  std::vector<FittedStump> stumps;  // feature = row of the matrix (stump stages)
-  std::vector<FittedTree> trees;    // tree stages (trainTreeStage()); feature = row of the matrix
+  std::vector<FittedStump> stumps;  // feature = row of the matrix
   double threshold = 0;             // stage passes when sum of stump outputs >= threshold
   double trainingThreshold = 0;     // the one the training positives alone give (== threshold without held-out)
   double hitRate = 0, falseAlarm = 0;  // on the training samples, at `threshold`
@@ -85,13 +79,6 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
                        const std::function<void(const RoundInfo&)>& onRound = {},
                        const HeldOutPositives* heldOut = nullptr, std::span<const double> startScores = {});
-
-// trainStage() with regression trees of depth config.treeDepth (>= 1) as weak learners
-// (regression_tree.h): the same Gentle AdaBoost loop, each round's f_m a tree instead of a stump;
-// held-out positives and start scores as there. Fills StageResult::trees.
-StageResult trainTreeStage(const FeatureMatrix& m, std::size_t positives, const FeatureValuesFn& rawValues,
-                           const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound = {},
-                           const HeldOutPositives* heldOut = nullptr, std::span<const double> startScores = {});
 
 // The starting weights of boostStage() for cumulative scores `start` ([0, positives) positives):
 // per class proportional to exp(-y F), each class summing to 1/2. Exposed for tests.

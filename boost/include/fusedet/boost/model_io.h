@@ -23,14 +23,6 @@
 //     ],
 //     "aspect_cascades": [ {a model object as above}, ... ]   (version 4; optional; absent = none)
 //   }
-//
-// Tree weak classifiers (version 5, TrainingConfig::treeDepth > 1): every stage holds "trees"
-// instead of "stumps", one tree per line - its nodes (a stump's feature fields and threshold,
-// "left"/"right" = children in cascade.h's Tree convention: > 0 a later node, <= 0 the leaf -child)
-// and its leaf values:
-//       {"threshold":-0.41,"trees":[
-//         {"nodes":[{"type":"g","rect":[...],"layer":"distance","threshold":0.12,"left":1,"right":-2},
-//                   {"type":"a",...,"left":0,"right":-1}],"leaves":[-0.8,0.1,0.5]},
 
 #include <filesystem>
 #include <stdexcept>
@@ -46,10 +38,12 @@ namespace fusedet::boosting {
 // standard deviation, feature.h); version 3 adds "cascade": "soft" (cascade.h: cumulative stage
 // sums; an older build refuses the file instead of running it as a hard cascade); version 4 adds
 // "aspect_cascades" (cascade.h: further cascades of the class at their own window aspect, e.g.
-// side views; an older build would detect with the first cascade only); version 5 adds tree weak
-// classifiers ("trees"; an older build refuses the file). Models without them are still written
-// as version 1, byte for byte as before. Every version loads.
-inline constexpr int kModelFormatVersion = 5;
+// side views; an older build would detect with the first cascade only). Models without them are
+// still written as version 1, byte for byte as before. Every version loads.
+// Versions of options that measured no gain across drives were removed with them (issue 29):
+// loading such a file fails with a ModelError naming the version, the option and what to do
+// (retrain with `fusedet train`): version 5 (tree weak learners).
+inline constexpr int kModelFormatVersion = 4;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.

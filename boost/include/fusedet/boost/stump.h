@@ -52,13 +52,6 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
                                              std::span<const float> weights, std::size_t k,
                                              int threads = 0);
 
-// The same over the samples of one tree node (regression_tree.h): `samples` are increasing matrix
-// columns, [0, positives) of them positives, weights[i] the weight of samples[i]. Only their
-// histograms are built, so a node costs in proportion to its samples.
-std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::span<const std::uint32_t> samples,
-                                             std::size_t positives, std::span<const float> weights,
-                                             std::size_t k, int threads = 0);
-
 // Exact weighted least-squares stump of one feature from its raw values (same sample order).
 FittedStump fitStumpExact(std::size_t feature, std::span<const float> values,
                           std::span<const float> weights, std::size_t positives);
