@@ -108,8 +108,6 @@ struct ExperimentOptions {
   int validationPart = -1;  // -1 = the preset's
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
-  bool softCascade = false;
-  std::string softStartWeights = "margin";
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
   std::string trainingPositives = "moderate";      // boost/class_rules.h TrainingPositives (training only)
   // Ablations of "training that generalises" (issue 15), each off by default.
@@ -446,8 +444,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.match = match;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
-  c.softCascade = o.softCascade;
-  c.stage.marginStartWeights = o.softStartWeights == "margin";
   c.samples.jitterCopies = o.jitter;
   c.samples.flipPositives = !o.noMirror;
   c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
@@ -761,9 +757,6 @@ int runExperiments(ExperimentOptions o) {
                                                ", person and bike " + shortNum(boosting::kittiMinOverlap("person"))},
       {"minimum detection height", o.minHeightFromPositives ? "smallest training positive (model's min_height)"
                                                             : "base window"},
-      {"cascade", o.softCascade ? "soft (cumulative stage sums; detection score = the final cumulative sum; start weights " +
-                                      o.softStartWeights + ")"
-                                : std::string("hard")},
       {"fold model cache", cache.string()},
       {"jittered copies per positive", std::to_string(o.jitter)},
       {"training positives (--training-positives)", trainingPositivesText(o)},
@@ -1429,14 +1422,6 @@ const bool registered = registerCommand(
       app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
                    "models store their smallest training positive's height as minimum detection height "
                    "(default: detection scans from the base window)");
-      app.add_flag("--soft-cascade", o->softCascade,
-                   "train soft cascades (as `fusedet train --soft-cascade`: every stage boosts on from the "
-                   "cumulative score and thresholds it); part of the fold-model cache key. Default: hard cascades");
-      app.add_option("--soft-start-weights", o->softStartWeights,
-                     "with --soft-cascade: a stage's first-round weights, 'margin' (exp(-y F)) or 'uniform' (as a hard "
-                     "stage), as `fusedet train --soft-start-weights`")
-          ->check(CLI::IsMember({"margin", "uniform"}))
-          ->capture_default_str();
       app.add_option("--max-fa", o->stageMaxFalseAlarm,
                      "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
                      "longer stages whose sums average more stumps")

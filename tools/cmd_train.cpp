@@ -51,8 +51,6 @@ struct TrainOptions {
   int validationPart = 0;
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
-  bool softCascade = false;
-  std::string softStartWeights = "margin";
   boosting::TrainingConfig::SideView sideView;  // off by default
   bool vanNegative = false;
   std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
@@ -221,8 +219,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.part = o.validationPart;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
-  c.softCascade = o.softCascade;
-  c.stage.marginStartWeights = o.softStartWeights == "margin";
   c.sideView = o.sideView;
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
@@ -345,7 +341,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
   if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
-  if (c.softCascade) info.emplace_back("cascade", "soft, start weights " + o.softStartWeights);
   if (c.sideView.minAspect > 0)
     info.emplace_back("side_view", cascade.aspectCascades.empty()
                                        ? "none trained (too few positives with w/h >= " + std::to_string(o.sideView.minAspect) + ")"
@@ -461,18 +456,6 @@ const bool registered = registerCommand(
                    "store the smallest training positive's height in the model as its minimum detection height "
                    "(\"min_height\"; detection scans from there unless given a minimum size); default: scan from "
                    "the base window");
-      app.add_flag("--soft-cascade", o->softCascade,
-                   "train a soft cascade (boosting chain): each stage goes on boosting from the samples' "
-                   "cumulative score of the stages before (weights exp(-y F), each class half the weight) and its "
-                   "threshold applies to that cumulative sum; the model file records it (\"cascade\": \"soft\", "
-                   "format version 3). Not with --validation-part or MPI. Default: hard cascade (every stage's sum "
-                   "from 0)");
-      app.add_option("--soft-start-weights", o->softStartWeights,
-                     "with --soft-cascade: first-round weights of a stage, 'margin' = exp(-y F) of the samples' "
-                     "cumulative scores F (boosting chain), 'uniform' = each class uniform as in a hard stage (only "
-                     "the sums and thresholds carry the earlier stages)")
-          ->check(CLI::IsMember({"margin", "uniform"}))
-          ->capture_default_str();
       addSideViewOptions(app, o->sideView);
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "

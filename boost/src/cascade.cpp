@@ -74,7 +74,6 @@ void Cascade::validate() const {
       if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
     }
   }
-  if (soft && isOpenCv()) fail("an imported OpenCV cascade cannot be a soft cascade");
   if (isOpenCv() && !aspectCascades.empty()) fail("an imported OpenCV cascade cannot hold aspect cascades");
   for (std::size_t i = 0; i < aspectCascades.size(); ++i) {
     const Cascade& a = aspectCascades[i];

@@ -54,7 +54,6 @@ void TrainingConfig::validate() const {
   if (!(validation.minHit >= 0 && validation.minHit <= 1)) bad("validation min hit must be in [0, 1] (0 = training thresholds)");
   if (!(validation.maxCascadeFalseAlarm > 0 && validation.maxCascadeFalseAlarm <= 1))
     bad("validation: largest cascade false-alarm rate tried must be in (0, 1]");
-  if (softCascade && validation.part > 0) bad("a soft cascade cannot be trained with a validation part");
   if (!(samples.jitterShift >= 0 && samples.jitterShift < 0.5)) bad("jitter shift must be in [0, 0.5)");
   if (!(samples.jitterScale >= 0 && samples.jitterScale < 0.5)) bad("jitter scale must be in [0, 0.5)");
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
@@ -189,8 +188,6 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
   const std::vector<Feature> pool = generatePool(config.pool);
   report.poolSize = pool.size();
 
-  if (job && config.softCascade)
-    throw std::invalid_argument("training config: a soft cascade needs in-process training (not sharded)");
   if (job && config.validation.part > 0)
     throw std::invalid_argument("training config: a validation part needs in-process training (not sharded)");
   // The validation part (validation_part.h) is neither trained on nor harvested for negatives.
@@ -235,7 +232,6 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
   cascade.className = config.className;
   cascade.layers = layers;
   cascade.contrastNormalised = normalised;
-  cascade.soft = config.softCascade;
   cascade.referenceHue = refHue;
   cascade.windowHeight = config.samples.baseWindowHeight;
   const double aspect = config.samples.windowAspect > 0 ? config.samples.windowAspect : stacks.positiveAspect();
@@ -405,15 +401,10 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
       const FeatureValuesFn raw = [&](std::size_t f, std::span<float> out) {
         staged ? staged->feature(f, out) : all->feature(f, out);
       };
-      // Soft cascade: every sample's cumulative score so far, where this stage's boosting starts
-      // (the plain per-window evaluation: the detector's sums, bit for bit).
-      std::vector<double> start;
-      if (cascade.soft && !cascade.stages.empty())
-        for (const Sample& v : samples) start.push_back(evaluateWindow(cascade, stacks.integrals(v.stack), v.window).score);
       tb = Clock::now();
       matrixSeconds = std::chrono::duration<double>(tb - tm).count();
       matrixBytes = matrix.bytes();
-      r = trainStage(matrix, positives, raw, sc, onRound, heldPtr, start);
+      r = trainStage(matrix, positives, raw, sc, onRound, heldPtr);
     }
 
     Stage st;

@@ -37,8 +37,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << c.maxStages << " negatives " << c.negativesPerStage << " min_negatives " << c.minNegatives
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   if (c.minHeightFromPositives) d << "min_height_from_positives\n";
-  if (c.softCascade)  // only then: hard keys stay those of earlier caches
-    d << "soft_cascade" << (c.stage.marginStartWeights ? "" : " uniform_start_weights") << "\n";
   // Only when set: keys of configurations without them stay as they were.
   if (c.samples.minPositiveAspect > 0 || c.samples.windowAspect > 0)
     d << "positives min_aspect " << c.samples.minPositiveAspect << " window_aspect " << c.samples.windowAspect << "\n";

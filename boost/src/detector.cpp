@@ -61,7 +61,7 @@ WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box
   if (!c.contrastNormalised.empty()) checkContrastNormalisation(c, in, "evaluateWindow");
   WindowResult r;
   for (const Stage& st : c.stages) {
-    double sum = c.soft ? r.score : 0;  // soft cascade: the cumulative score so far
+    double sum = 0;
     for (const Stump& t : st.stumps) {
       const float v = featureValue(in, c.features[static_cast<std::size_t>(t.feature)], window);
       sum += v < static_cast<float>(t.threshold) ? t.left : t.right;

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
-#include <tuple>
 #include <stdexcept>
 
 namespace fusedet::boosting {
@@ -18,21 +16,6 @@ double stageThreshold(std::vector<double> scores, double minHit) {
   return t - 1e-9 * std::max(1.0, std::fabs(t));
 }
 
-std::vector<double> softStartWeights(std::span<const double> start, std::size_t positives) {
-  const std::size_t n = start.size();
-  std::vector<double> w(n);
-  for (const auto& [lo, hi, y] : {std::tuple{std::size_t(0), positives, 1.0}, std::tuple{positives, n, -1.0}}) {
-    if (lo >= hi) continue;
-    // exp(-y F - m) with m the class's largest exponent: no overflow for any F, the same ratios.
-    double m = -std::numeric_limits<double>::infinity();
-    for (std::size_t i = lo; i < hi; ++i) m = std::max(m, -y * start[i]);
-    double sum = 0;
-    for (std::size_t i = lo; i < hi; ++i) sum += w[i] = std::exp(-y * start[i] - m);
-    for (std::size_t i = lo; i < hi; ++i) w[i] = 0.5 * w[i] / sum;
-  }
-  return w;
-}
-
 namespace {
 
 // The Gentle AdaBoost loop of boostStage(). fit(weights, outputs) fits one round's stump, writes
@@ -41,23 +24,16 @@ namespace {
 template <class Fit, class HeldOutputs>
 StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOutputs&& heldOutputs,
                         const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                        const HeldOutPositives* heldOut, std::span<const double> startScores) {
+                        const HeldOutPositives* heldOut) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
-  if (!startScores.empty() && startScores.size() != n)
-    throw std::invalid_argument("trainStage: " + std::to_string(startScores.size()) + " start scores for " +
-                                std::to_string(n) + " samples");
-  if (!startScores.empty() && heldOut)
-    throw std::invalid_argument("trainStage: held-out positives and start scores (soft cascade) together are not supported");
   // Each class starts with half the weight, so the first stump is not dominated by the larger set.
   std::vector<double> w(n);
   for (std::size_t i = 0; i < n; ++i)
     w[i] = i < positives ? 0.5 / double(positives) : 0.5 / double(n - positives);
-  if (!startScores.empty() && config.marginStartWeights) w = softStartWeights(startScores, positives);
   std::vector<float> wf(n);
   std::vector<double> score(n, 0.0);
-  if (!startScores.empty()) score.assign(startScores.begin(), startScores.end());
   std::vector<double> outputs(n);
   const std::size_t held = heldOut ? heldOut->count : 0;
   std::vector<double> heldScore(held, 0.0);
@@ -108,7 +84,7 @@ StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOut
 
 StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
                        const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                       const HeldOutPositives* heldOut, std::span<const double> startScores) {
+                       const HeldOutPositives* heldOut) {
   std::vector<float> values(n), heldValues(heldOut ? heldOut->count : 0);
   return boostRounds(
       n, positives,
@@ -125,13 +101,12 @@ StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& 
         heldOut->values(s.feature, heldValues);
         for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(heldValues[i]);
       },
-      config, onRound, heldOut, startScores);
+      config, onRound, heldOut);
 }
 
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut,
-                       std::span<const double> startScores) {
+                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut) {
   StumpSearchOptions search;
   search.threads = config.threads;
   search.refineTop = config.refineTop;
@@ -142,7 +117,7 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
         rawValues(s.feature, chosen);
         return s;
       },
-      config, onRound, heldOut, startScores);
+      config, onRound, heldOut);
 }
 
 }  // namespace fusedet::boosting

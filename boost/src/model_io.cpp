@@ -75,6 +75,7 @@ struct RemovedVersion {
   const char* option;
 };
 constexpr RemovedVersion kRemovedVersions[] = {
+    {3, "soft cascade"},
     {5, "tree weak learners"},
 };
 
@@ -96,15 +97,14 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"format\": " << Json(kModelFormatName).dump() << ",\n";
   // Such a model must not load in a build that would ignore the field and decide differently;
   // every other model keeps its bytes.
-  // Version 1 unless a layer is contrast-normalised (2), the cascade is soft (3) or it holds
+  // Version 1 unless a layer is contrast-normalised (2) or it holds
   // aspect cascades (4).
-  o << "  \"version\": " << (!c.aspectCascades.empty() ? 4 : c.soft ? 3 : normalised.empty() ? 1 : 2) << ",\n";
+  o << "  \"version\": " << (!c.aspectCascades.empty() ? 4 : normalised.empty() ? 1 : 2) << ",\n";
   o << "  \"class\": " << Json(c.className).dump() << ",\n";
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
   if (!normalised.empty()) o << "  \"contrast_normalised\": " << Json(normalised).dump() << ",\n";
-  if (c.soft) o << "  \"cascade\": \"soft\",\n";  // optional: absent = hard (every older file)
   if (c.minHeight > 0) o << "  \"min_height\": " << c.minHeight << ",\n";  // optional: older files lack it
   if (!info.empty()) {
     Json t = Json::object();
@@ -198,15 +198,6 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
       c.contrastNormalised[l] = true;
     }
     if (cn.empty()) c.contrastNormalised.clear();
-  }
-  // Optional: absent = a hard cascade (every file before version 3).
-  if (root.contains("cascade")) {
-    const std::string kind = r.string(root, "", "cascade");
-    if (kind == "soft")
-      c.soft = true;
-    else if (kind != "hard")
-      r.fail("cascade", "unknown cascade kind '" + kind + "' (expected \"hard\" or \"soft\")");
-    if (c.soft && version < 3) r.fail("cascade", "a soft cascade needs format version 3, the file says " + std::to_string(version));
   }
   if (root.contains("min_height")) c.minHeight = r.integer(root, "", "min_height", 0, 1 << 16);
   const Json& stages = r.array(root, "", "stages");

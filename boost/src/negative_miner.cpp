@@ -80,7 +80,7 @@ NegativeMiner::~NegativeMiner() = default;
 bool NegativeMiner::extends(const Cascade& c) const {
   if (!started_ || c.windowWidth != applied_.windowWidth || c.windowHeight != applied_.windowHeight ||
       c.layers != applied_.layers || c.referenceHue != applied_.referenceHue ||
-      c.contrastNormalised != applied_.contrastNormalised || c.soft != applied_.soft ||
+      c.contrastNormalised != applied_.contrastNormalised ||
       c.stages.size() < applied_.stages.size())
     return false;
   for (std::size_t i = 0; i < applied_.stages.size(); ++i)
@@ -97,7 +97,6 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
     applied_ = cascade;
     applied_.stages.clear();
     alive_.assign(n, {});
-    score_.assign(n, {});
     windows_.assign(n, 0);
     scales_.assign(n, {});
     forEachStack(n, threads, [&](std::size_t s) {
@@ -116,7 +115,6 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
               alive.push_back(static_cast<std::uint32_t>(k));
             ++k;
           }
-      if (applied_.soft) score_[s].assign(alive.size(), 0.0);
     });
     started_ = true;
   }
@@ -142,23 +140,17 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
     std::vector<double> contrast(nl, 1.0);
     std::size_t stumps = 0;
     std::vector<std::uint32_t>& alive = alive_[s];
-    std::vector<double>& score = score_[s];  // soft cascades: each alive window's score so far
     std::size_t kept = 0;
-    for (std::size_t i = 0; i < alive.size(); ++i) {
-      const std::uint32_t k = alive[i];
+    for (const std::uint32_t k : alive) {
       const WindowIndex w = order.at(k);
       const ScalePlan& sp = plans[w.scale];
       for (std::size_t l = 0; l < nl; ++l) base[l] = layerData[l] + sp.rowOfs[l][w.row] + sp.colOfs[l][w.column];
       for (const ScalePlan::Contrast& c : sp.contrasts)
         sqBase[c.layer] = sqData[c.layer] + sp.rowOfs[c.layer][w.row] + sp.colOfs[c.layer][w.column];
       windowContrasts(sp, base.data(), sqBase.data(), contrast.data());
-      const WindowResult r = runWindow(sp, base.data(), contrast.data(), stumps, fresh.soft ? score[i] : 0.0);
-      if (!r.accepted) continue;
-      if (fresh.soft) score[kept] = r.score;
-      alive[kept++] = k;
+      if (runWindow(sp, base.data(), contrast.data(), stumps).accepted) alive[kept++] = k;
     }
     alive.resize(kept);
-    if (fresh.soft) score.resize(kept);
   });
   applied_.features = cascade.features;
   applied_.stages = cascade.stages;

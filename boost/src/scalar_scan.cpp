@@ -18,7 +18,6 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
   std::vector<ScalePlan> plans;
   for (ScaleWindows& win : windowScales(c, W, H, p)) {
     ScalePlan sp;
-    sp.soft = c.soft;
     sp.winW = win.winW;
     sp.winH = win.winH;
     sp.step = win.step;

@@ -51,7 +51,6 @@ struct ScalePlan {
   std::vector<Contrast> contrasts;
   std::vector<ScaledStump> stumps;
   std::vector<ScaledStage> stages;
-  bool soft = false;  // Cascade::soft: stage sums start from the window's score so far
 };
 
 // Plans of every scale windowScales() gives for `c` on `in` (our models only).
@@ -69,14 +68,11 @@ inline void windowContrasts(const ScalePlan& sp, const double* const* base, cons
 
 // The hot loop: same arithmetic, in the same order, as featureValue() + evaluateWindow().
 // contrast: per layer, windowContrasts() of this window (read for normalised stumps only).
-// carried: a soft cascade's score after the stages before the plan's first (negative mining
-// applies only the stages a window has not passed yet); ignored by hard cascades.
 inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, const double* contrast,
-                              std::size_t& stumps, double carried = 0) {
+                              std::size_t& stumps) {
   WindowResult r;
-  r.score = carried;
   for (const ScaledStage& st : sp.stages) {
-    double sum = sp.soft ? r.score : 0;
+    double sum = 0;
     for (std::size_t k = st.begin; k < st.end; ++k) {
       const ScaledStump& z = sp.stumps[k];
       const double* p = base[z.layer];

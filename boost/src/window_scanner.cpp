@@ -97,14 +97,12 @@ struct GridScale {
   // kQuickMarginRelative, or +inf when quick decisions are off (setQuickStumpDecisions): then no
   // lane is ever sure and every stump takes the exact fallback.
   double quickMarginRelative = kQuickMarginRelative;
-  bool soft = false;  // Cascade::soft: a later stage's sum starts from the window's score so far
 };
 
 // slots[l]: where layer l's sums live; sqSlots[l]: its squared sums (contrast-normalised layers).
 GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector<SlotRef>& slots,
                     const std::vector<SlotRef>& sqSlots, ScaleWindows win) {
   GridScale sp;
-  sp.soft = c.soft;
   if (!gQuickDecisions.load(std::memory_order_relaxed)) sp.quickMarginRelative = std::numeric_limits<double>::infinity();
   const int W = in.refWidth(), H = in.refHeight();
   const std::size_t ng = in.grids().size();
@@ -282,9 +280,8 @@ void windowContrasts(const GridScale& sp, const void* const* grids, WindowList& 
 std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* const* grids, WindowList& l,
                         std::size_t n) {
   std::size_t kept = 0;
-  const bool carry = sp.soft && &st != &sp.stages.front();  // stage 0 starts from 0 either way
   for (std::size_t i = 0; i < n; ++i) {
-    double sum = carry ? l.score[i] : 0;
+    double sum = 0;
     for (std::uint32_t k = st.begin; k < st.end; ++k) {
       const GridStump& z = sp.stumps[k];
       const std::int32_t o = l.offsets(static_cast<std::size_t>(z.grid))[i];

@@ -79,17 +79,6 @@ Cascade normalisedVariant(Cascade c) {
   return c;
 }
 
-// A soft-cascade variant of a bundled model (cascade.h): the same stumps, stage k's threshold the
-// sum of the hard thresholds of stages 1..k. A window whose every stage sum passes has a
-// cumulative sum above it, so the soft variant accepts at least the hard one's windows, and more
-// whose strong early stages carry weak later ones.
-Cascade softVariant(Cascade c) {
-  c.soft = true;
-  double cumulative = 0;
-  for (Stage& st : c.stages) st.threshold = cumulative += st.threshold;
-  return c;
-}
-
 }  // namespace
 
 TEST(MultiDetector, AllClassesInOnePassDecideAsEachClassAloneOnRealKittiStacks) {
@@ -230,64 +219,7 @@ void expectOptimisedScanEqualsPlainPerWindowEvaluation(const std::vector<Cascade
 }  // namespace
 
 TEST(MultiDetector, OptimisedScanEqualsPlainPerWindowEvaluation) {
-  expectOptimisedScanEqualsPlainPerWindowEvaluation(bundledModels(), "bundled (hard) models");
-}
-
-// The same for soft cascades (cumulative stage sums; soft variants of the bundled models): every
-// later stage of the optimised scanner starts from the survivor's score, as evaluateWindow() does.
-TEST(MultiDetector, OptimisedScanEqualsPlainPerWindowEvaluationForSoftCascades) {
-  std::vector<Cascade> models;
-  for (const Cascade& c : bundledModels()) models.push_back(softVariant(c));
-  expectOptimisedScanEqualsPlainPerWindowEvaluation(models, "soft variants");
-}
-
-// Soft and hard models in one pass, in the scalar, AVX2 and AVX-512 forms and on the per-class
-// scalar path (Detector::scan(IntegralStack), the scanner negative mining shares): identical.
-TEST(MultiDetector, SoftCascadesDecideAsEachAloneInEveryForm) {
-  std::vector<Cascade> models = bundledModels();
-  models[0] = softVariant(models[0]);
-  models[2] = softVariant(models[2]);
-  const MultiDetector all(models);
-  ScanParams p;
-  p.scaleFactor = 1.15;
-  std::size_t hits = 0, softOnly = 0;
-  for (const LayerStack& s : {kittiStacks().front(), kittiStacks().back()}) {
-    std::vector<std::vector<RawHit>> want;
-    std::vector<ScanStats> ref(models.size());
-    for (std::size_t i = 0; i < models.size(); ++i) {
-      want.push_back(perClass(models[i], s, p, ref[i]));
-      hits += want.back().size();
-    }
-    ScanStats hardStats;
-    softOnly += want[0].size() - perClass(bundledModels()[0], s, p, hardStats).size();
-    for (int threads : {1, 2}) {
-      p.threads = threads;
-      setVectorScanEnabled(false);
-      const auto scalar = all.scan(s, p);
-      setVectorScanEnabled(true);
-      for (std::size_t i = 0; i < models.size(); ++i) expectSameHits(scalar[i], want[i], models[i].className + " scalar");
-      for (bool quick : {true, false}) {
-        setQuickStumpDecisions(quick);
-        for (int lanes : {8, 4}) {
-          setVectorLanesLimit(lanes);
-          std::vector<ScanStats> vs;
-          const auto vec = all.scan(s, p, &vs);
-          for (std::size_t i = 0; i < models.size(); ++i) {
-            const std::string what = models[i].className + (models[i].soft ? " (soft)" : " (hard)") + " on " +
-                                     s.source + ", " + std::to_string(lanes) + " lanes, quick " +
-                                     std::to_string(quick) + ", " + std::to_string(threads) + " threads";
-            expectSameHits(vec[i], want[i], what);
-            EXPECT_EQ(vs[i].stumps, ref[i].stumps) << what;
-          }
-        }
-      }
-      setQuickStumpDecisions(true);
-      setVectorLanesLimit(8);
-    }
-  }
-  std::printf("soft and hard in one pass: %zu raw hits, %zu more soft car hits than hard, identical in every form\n",
-              hits, softOnly);
-  EXPECT_GT(softOnly, 0u) << "the soft variant should accept windows the hard cascade rejects";
+  expectOptimisedScanEqualsPlainPerWindowEvaluation(bundledModels(), "bundled models");
 }
 
 // Each class's hue_distance is its own: models with different reference hues in one pass.

@@ -331,14 +331,6 @@ TEST(CrossValidation, TrainingKeyChangesWithConfigAndItems) {
   TrainingConfig w = v;
   w.validation.detection.group.minNeighbors = 2;
   EXPECT_NE(trainingKey(v, {"x/1"}), trainingKey(w, {"x/1"}));
-  // So does a soft cascade; hard descriptions do not mention it (earlier caches stay valid).
-  EXPECT_EQ(describeTrainingConfig(a).find("soft"), std::string::npos);
-  TrainingConfig soft = a;
-  soft.softCascade = true;
-  EXPECT_NE(trainingKey(a, {"x/1"}), trainingKey(soft, {"x/1"}));
-  TrainingConfig uniform = soft;
-  uniform.stage.marginStartWeights = false;
-  EXPECT_NE(trainingKey(soft, {"x/1"}), trainingKey(uniform, {"x/1"}));
 }
 
 }  // namespace

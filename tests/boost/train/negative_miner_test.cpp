@@ -182,33 +182,3 @@ TEST(NegativeMiner, TrainsTheSameContrastNormalisedModelAsTheFullRescan) {
   EXPECT_EQ(modelToText(fast), modelToText(old));
   EXPECT_EQ(b.stopReason, a.stopReason);
 }
-
-// A soft cascade's later stages start from each window's cumulative score: the miner carries it
-// per alive window; its harvests and the trained model equal the full rescan's (which evaluates
-// every window with the whole cascade), stage by stage.
-TEST(NegativeMiner, TrainsTheSameSoftCascadeAsTheFullRescan) {
-  TrainingConfig config = smallCarConfig();
-  config.softCascade = true;
-  config.maxStages = 4;
-  TrainingReport a, b;
-  const auto [old, fast] = trainBothWays(config, a, b);
-  ASSERT_GE(old.stages.size(), 3u) << a.stopReason;
-  ASSERT_TRUE(old.soft);
-  EXPECT_EQ(modelToText(fast), modelToText(old));
-  ASSERT_EQ(b.stages.size(), a.stages.size());
-  for (std::size_t s = 0; s < a.stages.size(); ++s)
-    EXPECT_EQ(b.stages[s].negativeCandidates, a.stages[s].negativeCandidates) << "stage " << s + 1;
-  config.samples.className = config.className;
-  const TrainingStacks stacks(kittiItems(), config.pool.layers, old.referenceHue, config.samples);
-  NegativeMiner miner(stacks);
-  for (std::size_t n = 0; n <= old.stages.size(); ++n) {
-    const Cascade part = withStages(old, n);
-    expectSameHarvest(miner.harvest(part, 300, 21 + n, 2), stacks.harvestNegatives(part, 300, 21 + n, 2),
-                      "soft, " + std::to_string(n) + " stages");
-  }
-  // The same stages run hard accept other windows (the flag is not ignored by the miner).
-  Cascade hard = withStages(old, old.stages.size());
-  hard.soft = false;
-  EXPECT_NE(NegativeMiner(stacks).harvest(hard, 300, 3, 2).candidates,
-            stacks.harvestNegatives(withStages(old, old.stages.size()), 300, 3, 2).candidates);
-}

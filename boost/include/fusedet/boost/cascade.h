@@ -7,12 +7,6 @@
 // >= its threshold (OpenCV rejects when sum < threshold, so both agree). A window is accepted
 // when it passes every stage; its score is the sum of the last stage.
 //
-// Soft cascade (`Cascade::soft`; Xiao et al.'s boosting chain, Bourdev & Brandt's soft cascade):
-// stage k's sum starts from the window's cumulative score after stage k-1 instead of 0, so the
-// evidence of earlier stages is kept; every stage threshold applies to that cumulative sum and
-// the score of an accepted window is the sum over all its stumps. Every evaluation path adds the
-// leaves in the same order (previous score first, then the stage's stumps), bit for bit.
-//
 // Two kinds of features, two clearly separated evaluation paths:
 //  - our models (Normalization::kNone): `features` are paper features a-j in unit-square window
 //    coordinates on any layer (feature.h); windows scan the layer stack directly; features on a
@@ -89,9 +83,6 @@ struct Cascade {
   std::vector<Feature> features;          // kNone
   std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
   std::vector<Stage> stages;
-  // Soft cascade (above): stage sums are cumulative. Model files record it ("cascade": "soft");
-  // OpenCV models are never soft.
-  bool soft = false;
   // OpenCV tree cascades only: the weak classifiers of stage i are treeStages[i] (instead of
   // stages[i].stumps, which stay empty; stages[i].threshold applies). Empty for every other model.
   std::vector<std::vector<Tree>> treeStages;
@@ -115,7 +106,7 @@ struct Cascade {
   // Throws std::invalid_argument naming `source` and the first problem: no stages, empty stage,
   // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
   // index out of range, hue_distance without a reference hue, OpenCV model without one layer,
-  // contrastNormalised not of the layers' size (or set on an OpenCV model), a soft OpenCV model,
+  // contrastNormalised not of the layers' size (or set on an OpenCV model),
   // an aspect cascade of another class, an OpenCV one, or one holding aspect cascades itself, trees
   // in one of our models, a tree stage count other than the stage count, a stage mixing stumps
   // and trees, a tree whose children do not follow their parent.

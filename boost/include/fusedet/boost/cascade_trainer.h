@@ -53,10 +53,6 @@ struct TrainingConfig {
   // Store the smallest training positive's height as the model's minimum detection height
   // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
   bool minHeightFromPositives = false;
-  // Soft cascade (cascade.h, gentle_boost.h boostStage's startScores): each stage goes on boosting
-  // from the samples' cumulative scores of the stages before, and its threshold applies to the
-  // cumulative sum. Off by default; in-process training without a validation part only.
-  bool softCascade = false;
   // Side-view cascade (Cascade::aspectCascades): minAspect > 0 = after the cascade (trained
   // exactly as without this), a second one of the class whose positives are only the labels with
   // w/h >= minAspect (mirrored and jittered alike), window windowAspect:1 at the same height,

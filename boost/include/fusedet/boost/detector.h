@@ -44,13 +44,13 @@ struct ScanParams {
 
 struct WindowResult {
   bool accepted = false;
-  double score = 0;      // sum of the last stage evaluated (soft cascade: the cumulative sum)
+  double score = 0;      // sum of the last stage evaluated
   int stagesPassed = 0;  // == stage count when accepted
 };
 
 struct RawHit {
   Box box;           // reference pixels
-  double score = 0;  // sum of the last stage (soft cascade: of every stump)
+  double score = 0;  // sum of the last stage
   int scale = 0;     // index of the scale the window was found at (over all stretches)
   int stretch = 0;   // index into ScanParams::widthStretches (0 when it is empty)
 };

@@ -21,10 +21,6 @@ struct StageConfig {
   int maxWeak = 100;  // rounds per stage at most
   int threads = 0;
   std::size_t refineTop = 4;
-  // Soft cascade stages (boostStage's startScores): the first round's weights exp(-y F) within
-  // each class (true, the boosting chain) or uniform within each class as in a hard stage (false:
-  // only the sums and the threshold carry the earlier stages' evidence).
-  bool marginStartWeights = true;
 };
 
 struct RoundInfo {
@@ -60,29 +56,17 @@ using StumpFinder = std::function<FittedStump(std::span<const float> weights, st
 
 // The Gentle AdaBoost loop over `samples` samples ([0, positives) are positives) with any stump
 // finder: trainStage() searches one in-process matrix, sharded_stage.h one sharded over ranks.
-//
-// startScores (empty = a hard cascade's stage: every sum starts at 0, each class starts with half
-// the weight, uniform within it): one per sample, a soft cascade's cumulative score F of the stages
-// before (cascade.h). Then boosting goes on from F (Xiao et al.'s boosting chain): sample i starts
-// with weight proportional to exp(-y_i F_i), each class still holding half the total weight (so
-// that the ~2:1 negatives do not outweigh the positives; StageConfig::marginStartWeights = false:
-// uniform within each class instead), and the stage threshold is placed on F + the stage's stumps,
-// added in the detector's order (F first, then stump by stump).
 StageResult boostStage(std::size_t samples, std::size_t positives, const StumpFinder& find,
                        const StageConfig& config,
                        const std::function<void(const RoundInfo&)>& onRound = {},
-                       const HeldOutPositives* heldOut = nullptr, std::span<const double> startScores = {});
+                       const HeldOutPositives* heldOut = nullptr);
 
 // Samples [0, positives) of `m` are positives. rawValues gives the raw values of a matrix row
 // (exact refinement and the update use them). onRound (optional) sees every round.
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
                        const std::function<void(const RoundInfo&)>& onRound = {},
-                       const HeldOutPositives* heldOut = nullptr, std::span<const double> startScores = {});
-
-// The starting weights of boostStage() for cumulative scores `start` ([0, positives) positives):
-// per class proportional to exp(-y F), each class summing to 1/2. Exposed for tests.
-std::vector<double> softStartWeights(std::span<const double> start, std::size_t positives);
+                       const HeldOutPositives* heldOut = nullptr);
 
 // Stage threshold for scores of the positives: the largest t with
 // |{s >= t}| >= ceil(minHit * n), nudged down by a relative 1e-9 so the detector's sums, added

@@ -12,7 +12,6 @@
 //     "layers": ["intensity","distance"],
 //     "reference_hue": 25,
 //     "contrast_normalised": ["intensity"],   (version 2 only; optional; absent = none)
-//     "cascade": "soft",                      (version 3; optional: "hard" | "soft", absent = hard)
 //     "training": {"seed":"1", ...},          (optional, informative, ignored when loading)
 //     "stages": [
 //       {"threshold":-0.41,"stumps":[
@@ -35,14 +34,13 @@
 namespace fusedet::boosting {
 
 // Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
-// standard deviation, feature.h); version 3 adds "cascade": "soft" (cascade.h: cumulative stage
-// sums; an older build refuses the file instead of running it as a hard cascade); version 4 adds
+// standard deviation, feature.h); version 4 adds
 // "aspect_cascades" (cascade.h: further cascades of the class at their own window aspect, e.g.
 // side views; an older build would detect with the first cascade only). Models without them are
 // still written as version 1, byte for byte as before. Every version loads.
 // Versions of options that measured no gain across drives were removed with them (issue 29):
 // loading such a file fails with a ModelError naming the version, the option and what to do
-// (retrain with `fusedet train`): version 5 (tree weak learners).
+// (retrain with `fusedet train`): versions 3 (soft cascade) and 5 (tree weak learners).
 inline constexpr int kModelFormatVersion = 4;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 

@@ -4,8 +4,7 @@
 // (TrainingStacks::harvestNegatives() rescans every window of every stack with the whole cascade).
 // A cascade only grows by appending stages, and a window rejected once stays rejected, so the
 // miner keeps, per stack, the indices of the label-free windows every stage applied so far
-// accepted, and evaluates only the newly appended stages on those (for a soft cascade it also
-// keeps each window's cumulative score, where the next stage's sum starts). Which windows are label-free
+// accepted, and evaluates only the newly appended stages on those. Which windows are label-free
 // is decided once (the labels do not change between stages).
 //
 // Same windows, same order (scale, row, column; stack by stack), same reservoir draws, same
@@ -51,7 +50,6 @@ class NegativeMiner {
   Cascade applied_;                              // window, layers and the stages applied so far
   bool started_ = false;
   std::vector<std::vector<std::uint32_t>> alive_;  // per original stack: window indices, scan order
-  std::vector<std::vector<double>> score_;  // soft cascades: the alive windows' cumulative scores
   std::vector<std::size_t> windows_;             // per original stack: windows of a full scan
   std::vector<std::vector<ScaleWindows>> scales_;  // per original stack: the scan's windows
 };
