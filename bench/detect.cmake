@@ -7,5 +7,5 @@ fusedet_bench(bench_detect_vs_opencv SOURCES detect_vs_opencv.cpp
 # and cv::CascadeClassifier (frontalface_default) on the same stack's intensity layer.
 fusedet_bench(bench_detect3 SOURCES detect3_bench.cpp
               DEPS fusedet_boost fusedet_fusion opencv_objdetect opencv_core CLI11::CLI11
-              SMOKE_ARGS --smoke --width-stretches 1,1.15,1.3)
+              SMOKE_ARGS --smoke)
 target_compile_definitions(bench_detect3 PRIVATE FUSEDET_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")

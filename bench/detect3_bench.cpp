@@ -82,14 +82,7 @@ struct Args {
   fs::path data = FUSEDET_DATA_DIR;
   fs::path models = FUSEDET_MODELS_DIR;
   std::string drive = "kitti";
-  std::vector<double> widthStretches;  // given: one more contender, the same pass at these stretches
 };
-
-std::string joinedStretches(const std::vector<double>& v) {
-  std::string out;
-  for (double x : v) out += (out.empty() ? "" : ",") + std::to_string(x).substr(0, 4);
-  return out;
-}
 
 // Command line (CLI11); exits after --help (0) or a bad argument (non-zero).
 Args parse(int argc, char** argv) {
@@ -105,10 +98,6 @@ Args parse(int argc, char** argv) {
   app.add_option("--data", a.data, "root of the shared data")->capture_default_str();
   app.add_option("--drive", a.drive, "KITTI drive folder under --data")->capture_default_str();
   app.add_option("--models", a.models, "folder with car.json, person.json, bike.json")->capture_default_str();
-  app.add_option("--width-stretches", a.widthStretches,
-                 "also time fusedetd's path (detectPerClass with classGroupings()) with these window width "
-                 "stretches (ScanParams::widthStretches, e.g. 1,1.15,1.3; every model), interleaved with the others")
-      ->delimiter(',');
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -175,16 +164,11 @@ int main(int argc, char** argv) try {
                 eq ? "identical" : "DIFFERENT");
   }
 
-  Timing ours, ours2, ours4lanes, previous, opencv, daemonPath, stretched;
-  std::size_t found = 0, foundPrev = 0, faces = 0, foundDaemonPath = 0, foundStretched = 0;
-  ScanParams stretchedScan = scan;
-  stretchedScan.widthStretches = a.widthStretches;
+  Timing ours, ours2, ours4lanes, previous, opencv, daemonPath;
+  std::size_t found = 0, foundPrev = 0, faces = 0, foundDaemonPath = 0;
   for (int r = 0; r < a.rounds; ++r) {
     ours.add([&] { found = detect(all, stack, scan, group).size(); });
     daemonPath.add([&] { foundDaemonPath = detectPerClass(all, stack, scan, group, noExtent, perClass).size(); });
-    if (!a.widthStretches.empty())
-      stretched.add(
-          [&] { foundStretched = detectPerClass(all, stack, stretchedScan, group, noExtent, perClass).size(); });
     opencv.add([&] {
       std::vector<cv::Rect> out;
       face.detectMultiScale(intensity, out, 1.1, 3);
@@ -215,10 +199,6 @@ int main(int argc, char** argv) try {
               minimum(previous.cpu), median(previous.wall), foundPrev);
   std::printf("  OpenCV frontalface_default, 1 thr:  %8.2f (%7.2f) / %8.2f  -> %zu faces (intensity layer %dx%d)\n",
               cvf, minimum(opencv.cpu), median(opencv.wall), faces, intensity.cols, intensity.rows);
-  if (!a.widthStretches.empty())
-    std::printf("  fusedetd's path, width stretches %s, 1 thread: %8.2f (%7.2f) / %8.2f  -> %zu detections\n",
-                joinedStretches(a.widthStretches).c_str(), median(stretched.cpu), minimum(stretched.cpu),
-                median(stretched.wall), foundStretched);
   std::printf("  ours, 2 threads: wall %.2f ms (min %.2f), process CPU %.2f ms; scaling vs 1 thread (wall) %.2fx\n",
               median(ours2.wall), minimum(ours2.wall), median(ours2.processCpu),
               median(ours2.wall) > 0 ? median(ours.wall) / median(ours2.wall) : 0.0);
@@ -242,10 +222,6 @@ int main(int argc, char** argv) try {
   std::printf("bench: opencv_face_ms %.3f\n", cvf);
   std::printf("bench: detect3_over_opencv_face %.3f\n", cvf > 0 ? d3 / cvf : 0.0);
   std::printf("bench: detect3_daemon_path_over_opencv_face %.3f\n", cvf > 0 ? d3k / cvf : 0.0);
-  if (!a.widthStretches.empty()) {
-    std::printf("bench: detect3_stretched_ms %.3f\n", median(stretched.cpu));
-    std::printf("bench: detect3_stretched_over_daemon_path %.3f\n", d3k > 0 ? median(stretched.cpu) / d3k : 0.0);
-  }
   return same == models.size() ? 0 : 1;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "bench_detect3: error: %s\n", e.what());

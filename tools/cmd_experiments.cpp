@@ -101,8 +101,6 @@ struct ExperimentOptions {
   boosting::TrainingConfig::SideView sideView;  // off by default
   double aspectMergeIou = 0.5;
   std::string aspectMerge = "first";
-  std::vector<double> widthStretches;  // ScanParams::widthStretches on the test frames; empty = none
-  std::string stretchGrouping = "alone";  // alone | together (GroupParams::groupStretchesTogether)
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -361,7 +359,6 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   g.depthRelative = o.depthRelative;
   g.depthMetres = o.depthMetres;
   g.aspectMergeIou = o.aspectMergeIou;
-  g.groupStretchesTogether = o.stretchGrouping == "together";
   g.aspectMerge = o.aspectMerge == "first" ? boosting::GroupParams::AspectMerge::kFirstCascadeFirst
                                            : boosting::GroupParams::AspectMerge::kByScore;
   return g;
@@ -386,15 +383,6 @@ std::string trainingPositivesText(const ExperimentOptions& o) {
   t += ", height >= " + shortNum(rule.minHeight > 0 ? rule.minHeight : 25) + " px";
   if (rule.vans) t += ", vans as car";
   return t + "; evaluation unchanged)";
-}
-
-std::string widthStretchesText(const ExperimentOptions& o) {
-  if (o.widthStretches.empty()) return "none (the model's window aspect only)";
-  std::string t;
-  for (double v : o.widthStretches) t += (t.empty() ? "" : ", ") + shortNum(v);
-  if (o.stretchGrouping == "together") return t + " x the model's window width, all stretches grouped together";
-  return t + " x the model's window width, each grouped alone, merged (" + o.aspectMerge + ") at IoU > " +
-         shortNum(o.aspectMergeIou);
 }
 
 std::string groupingText(const ExperimentOptions& o) {
@@ -686,8 +674,6 @@ int runExperiments(ExperimentOptions o) {
   setup.scan.threads = 1;  // ms per stack on one core, comparable across configurations
   setup.group = groupParams(o);
   setup.laserExtent.enabled = o.laserExtent;
-  setup.scan.widthStretches = o.widthStretches;
-  boosting::widthStretchesOf(setup.scan);  // a bad list is refused before any training or detection
   // A class's own detection settings (class_detection.h) where the preset uses them, unless the
   // command line set that option for every class.
   const bool perClass = preset.classDetection && o.classDetection;
@@ -761,7 +747,6 @@ int runExperiments(ExperimentOptions o) {
       {"jittered copies per positive", std::to_string(o.jitter)},
       {"training positives (--training-positives)", trainingPositivesText(o)},
       {"side-view cascade (--side-view)", sideViewText(o)},
-      {"window width stretches (--width-stretches)", widthStretchesText(o)},
   };
   // Only when set: reports of default runs stay as they were.
   if (o.noMirror) report.settings["mirrored positives (--no-mirror)"] = "off";
@@ -1379,28 +1364,15 @@ const bool registered = registerCommand(
                    "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
                    "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
       addSideViewOptions(app, o->sideView);
-      app.add_option("--width-stretches", o->widthStretches,
-                     "scan the test frames (and the miss analysis' windows) also at wider windows of the same "
-                     "cascades: comma-separated factors on the model's window width at the same heights, e.g. "
-                     "1,1.3,1.6 (features stretch with the window; boost/detector.h ScanParams::widthStretches); "
-                     "each stretch's hits are grouped alone and merged by --aspect-merge / --aspect-merge-iou, "
-                     "listed order first; every class; default: none (the model's aspect only)")
-          ->delimiter(',');
-      app.add_option("--stretch-grouping", o->stretchGrouping,
-                     "--width-stretches: 'alone' = each stretch's hits grouped alone, the groups merged by "
-                     "--aspect-merge; 'together' = the hits of every stretch grouped as one list (a group's box "
-                     "is its members' average)")
-          ->check(CLI::IsMember({"alone", "together"}))
-          ->capture_default_str();
       app.add_option("--aspect-merge", o->aspectMerge,
-                     "models with aspect cascades or --width-stretches: 'first' = the model's own cascade (the "
-                     "first stretch) first, a later one only adds detections where it found none; 'score' = "
-                     "overlapping detections of different cascades or stretches keep the higher-scored one")
+                     "models with aspect cascades: 'first' = the model's own cascade first, an aspect cascade only "
+                     "adds detections where it found none; 'score' = overlapping detections of different cascades "
+                     "keep the higher-scored one")
           ->check(CLI::IsMember({"score", "first"}))
           ->capture_default_str();
       app.add_option("--aspect-merge-iou", o->aspectMergeIou,
-                     "models with aspect cascades or --width-stretches: a detection overlapping an already kept "
-                     "one of another of the model's cascades or stretches by IoU above this is dropped")
+                     "models with aspect cascades: a detection overlapping an already kept one of another of the "
+                     "model's cascades by IoU above this is dropped")
           ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       app.add_option("--contrast-normalise", o->contrastNormalise,

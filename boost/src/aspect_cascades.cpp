@@ -73,44 +73,14 @@ std::vector<Detection> groupModelHits(const Cascade& model, const std::vector<st
   std::vector<std::vector<HitFate>> local(cascades.size());
   std::vector<std::vector<HitFate>>& f = fates ? *fates : local;
   f.assign(cascades.size(), {});
-  // One list per (cascade, width stretch) in that order, each grouped alone: windows of different
-  // widths are not linked by the grouping's edge rule, the merge below decides between them.
-  struct List {
-    std::size_t cascade;
-    std::vector<std::size_t> hit;  // indices into hits[cascade]
-  };
-  std::vector<List> lists;
-  std::vector<std::vector<Detection>> perList;
-  for (std::size_t k = 0; k < cascades.size(); ++k) {
-    f[k].resize(hits[k].size());
-    int stretches = 1;
-    for (const RawHit& h : hits[k]) {
-      if (h.stretch < 0) throw std::invalid_argument("groupModelHits: a hit with a negative stretch index");
-      stretches = std::max(stretches, h.stretch + 1);
-    }
-    const bool together = group.groupStretchesTogether;
-    for (int s = 0; s < (together ? 1 : stretches); ++s) {
-      List l{k, {}};
-      std::vector<RawHit> own;
-      for (std::size_t i = 0; i < hits[k].size(); ++i)
-        if (together || hits[k][i].stretch == s) {
-          l.hit.push_back(i);
-          own.push_back(hits[k][i]);
-        }
-      if (own.empty() && s > 0) continue;
-      std::vector<HitFate> ownFates;
-      perList.push_back(groupHits(own, group, model.className, stack, &ownFates));
-      for (std::size_t j = 0; j < l.hit.size(); ++j) f[k][l.hit[j]] = ownFates[j];
-      lists.push_back(std::move(l));
-    }
-  }
-  if (perList.size() == 1) return std::move(perList.front());
-  MergedDetections merged = mergeCascadeDetections(perList, group.aspectMergeIou, group.aspectMerge);
-  for (std::size_t m = 0; m < lists.size(); ++m)
-    for (std::size_t i : lists[m].hit) {
-      HitFate& h = f[lists[m].cascade][i];
-      if (h.detection >= 0) h.detection = merged.kept[m][static_cast<std::size_t>(h.detection)];
-    }
+  std::vector<std::vector<Detection>> perCascade;
+  for (std::size_t k = 0; k < cascades.size(); ++k)
+    perCascade.push_back(groupHits(hits[k], group, model.className, stack, &f[k]));
+  if (perCascade.size() == 1) return std::move(perCascade.front());
+  MergedDetections merged = mergeCascadeDetections(perCascade, group.aspectMergeIou, group.aspectMerge);
+  for (std::size_t k = 0; k < f.size(); ++k)
+    for (HitFate& h : f[k])
+      if (h.detection >= 0) h.detection = merged.kept[k][static_cast<std::size_t>(h.detection)];
   return std::move(merged.detections);
 }
 

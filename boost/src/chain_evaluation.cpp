@@ -74,7 +74,7 @@ std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain
         if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
       hits[0] = std::move(kept);
     }
-    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);  // stretches alone
+    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);
   }
   if (groups)
     refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);

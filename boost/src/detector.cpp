@@ -139,7 +139,7 @@ std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& pa
         const WindowResult r = runWindow(sp, base.data(), contrast.data(), stumps);
         if (r.accepted)
           hits[i].push_back(RawHit{Box{double(sp.xs[xi]), double(sp.ys[yi]), double(sp.winW), double(sp.winH)},
-                                   r.score, static_cast<int>(it.scale), sp.stretch});
+                                   r.score, static_cast<int>(it.scale)});
       }
     }
     stumpCount[i] = stumps;

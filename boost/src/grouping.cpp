@@ -1,7 +1,5 @@
 #include "fusedet/boost/grouping.h"
 
-#include "fusedet/boost/aspect_cascades.h"
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -192,8 +190,8 @@ std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams
 
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group) {
-  // Each cascade of the model and each width stretch grouped alone, then merged (aspect_cascades.h).
-  return groupModelHits(detector.cascade(), scanModel(detector, stack, scan), group, stack);
+  const std::vector<RawHit> hits = detector.scan(stack, scan);
+  return groupHits(hits, group, detector.cascade().className, stack);
 }
 
 }  // namespace fusedet::boosting

@@ -21,7 +21,6 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
     sp.winW = win.winW;
     sp.winH = win.winH;
     sp.step = win.step;
-    sp.stretch = win.stretch;
     sp.xs = std::move(win.xs);
     sp.ys = std::move(win.ys);
     const std::size_t nl = in.size();

@@ -39,7 +39,6 @@ struct ScaledStage {
 
 struct ScalePlan {
   int winW = 0, winH = 0, step = 1;
-  int stretch = 0;  // ScaleWindows::stretch
   std::vector<int> xs, ys;                       // window positions (reference pixels)
   std::vector<std::vector<std::ptrdiff_t>> colOfs, rowOfs;  // per layer, per position
   // Per contrast-normalised layer: the layer window's corners and area (windowContrast()).

@@ -12,7 +12,6 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
-#include <string>
 #include <tuple>
 
 #include "fusedet/boost/float_cut.h"
@@ -568,7 +567,7 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
     hits.push_back(RawHit{Box{double(sp.win.xs[static_cast<std::size_t>(l.xi[k])]),
                               double(sp.win.ys[static_cast<std::size_t>(l.yi[k])]), double(sp.win.winW),
                               double(sp.win.winH)},
-                          l.score[k], scaleIndex, sp.win.stretch});
+                          l.score[k], scaleIndex});
 }
 
 }  // namespace
@@ -586,36 +585,18 @@ std::vector<ScaleWindows> windowScales(const Cascade& c, int W, int H, const Sca
   if (p.minWidth > 0 || p.minHeight > 0)
     s0 = std::max(double(p.minWidth) / c.windowWidth, double(p.minHeight) / c.windowHeight);
   std::vector<ScaleWindows> out;
-  // Stretch by stretch (the listed order), each over the same scales; stretch 1 gives exactly the
-  // windows of the model's own aspect (x 1.0 is exact).
-  const std::vector<double> stretches = widthStretchesOf(p);
-  for (std::size_t k = 0; k < stretches.size(); ++k)
-    for (double s = s0;; s *= p.scaleFactor) {
-      ScaleWindows sw;
-      sw.stretch = static_cast<int>(k);
-      sw.winW = std::max(1, roundHalfUp(c.windowWidth * stretches[k] * s));
-      sw.winH = std::max(1, roundHalfUp(c.windowHeight * s));
-      if (sw.winW > maxW || sw.winH > maxH) break;
-      if (sw.winW < p.minWidth || sw.winH < p.minHeight) continue;
-      sw.step = std::max(1, roundHalfUp(p.step * s));
-      for (int x = 0; x + sw.winW <= W; x += sw.step) sw.xs.push_back(x);
-      for (int y = 0; y + sw.winH <= H; y += sw.step) sw.ys.push_back(y);
-      out.push_back(std::move(sw));
-    }
-  return out;
-}
-
-std::vector<double> widthStretchesOf(const ScanParams& params) {
-  if (params.widthStretches.empty()) return {1.0};
-  for (std::size_t k = 0; k < params.widthStretches.size(); ++k) {
-    const double v = params.widthStretches[k];
-    if (!(v > 0) || !std::isfinite(v))
-      throw std::invalid_argument("window width stretch must be a positive number (got " + std::to_string(v) + ")");
-    for (std::size_t j = 0; j < k; ++j)
-      if (params.widthStretches[j] == v)
-        throw std::invalid_argument("window width stretch " + std::to_string(v) + " given twice");
+  for (double s = s0;; s *= p.scaleFactor) {
+    ScaleWindows sw;
+    sw.winW = std::max(1, roundHalfUp(c.windowWidth * s));
+    sw.winH = std::max(1, roundHalfUp(c.windowHeight * s));
+    if (sw.winW > maxW || sw.winH > maxH) break;
+    if (sw.winW < p.minWidth || sw.winH < p.minHeight) continue;
+    sw.step = std::max(1, roundHalfUp(p.step * s));
+    for (int x = 0; x + sw.winW <= W; x += sw.step) sw.xs.push_back(x);
+    for (int y = 0; y + sw.winH <= H; y += sw.step) sw.ys.push_back(y);
+    out.push_back(std::move(sw));
   }
-  return params.widthStretches;
+  return out;
 }
 
 std::vector<LayerRequest> layerRequests(const Cascade& c) {

@@ -20,11 +20,9 @@
 namespace fusedet::boosting {
 
 // Window sizes and positions of one scale (reference pixels): sizes grow from the minimum size by
-// the scale factor at the model's aspect ratio, the position step grows with them; with width
-// stretches (ScanParams::widthStretches) all scales of the first stretch, then of the next, ...
+// the scale factor at the model's aspect ratio, the position step grows with them.
 struct ScaleWindows {
   int winW = 0, winH = 0, step = 1;
-  int stretch = 0;  // index into widthStretchesOf(params)
   std::vector<int> xs, ys;
 };
 std::vector<ScaleWindows> windowScales(const Cascade& c, int refWidth, int refHeight, const ScanParams& p);

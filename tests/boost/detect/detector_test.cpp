@@ -7,7 +7,6 @@
 
 #include <opencv2/core.hpp>
 #include <cmath>
-#include <limits>
 #include <random>
 #include <string>
 
@@ -52,32 +51,32 @@ LayerStack randomStack(unsigned seed) {
 }
 
 // Every window of the documented geometry (sizes from the 16 x 24 base window by the scale factor,
-// each width stretch in order, step 2 x scale; all rounded half up) on the 120 x 80 test stack,
-// decided the slow way by evaluateWindow(); `windows` counts them.
+// step 2 x scale; all rounded half up) on the 120 x 80 test stack, decided the slow way by
+// evaluateWindow(); `windows` counts them.
 std::vector<RawHit> plainScan(const Cascade& c, const IntegralStack& in, const ScanParams& p, std::size_t& windows) {
   std::vector<RawHit> expect;
   windows = 0;
   int scale = 0;
-  const std::vector<double> stretches = widthStretchesOf(p);
-  for (std::size_t k = 0; k < stretches.size(); ++k)
-    for (double f = 1;; f *= p.scaleFactor) {
-      const int w = int(std::floor(16 * stretches[k] * f + 0.5)), h = int(std::floor(24 * f + 0.5));
-      if (w > 120 || h > 80) break;
-      const int step = std::max(1, int(std::floor(2 * f + 0.5)));
-      for (int y = 0; y + h <= 80; y += step)
-        for (int x = 0; x + w <= 120; x += step) {
-          ++windows;
-          const Box box{double(x), double(y), double(w), double(h)};
-          const WindowResult r = evaluateWindow(c, in, box);
-          if (r.accepted) expect.push_back(RawHit{box, r.score, scale, static_cast<int>(k)});
-        }
-      ++scale;
-    }
+  for (double f = 1;; f *= p.scaleFactor) {
+    const int w = int(std::floor(16 * f + 0.5)), h = int(std::floor(24 * f + 0.5));
+    if (w > 120 || h > 80) break;
+    const int step = std::max(1, int(std::floor(2 * f + 0.5)));
+    for (int y = 0; y + h <= 80; y += step)
+      for (int x = 0; x + w <= 120; x += step) {
+        ++windows;
+        const Box box{double(x), double(y), double(w), double(h)};
+        const WindowResult r = evaluateWindow(c, in, box);
+        if (r.accepted) expect.push_back(RawHit{box, r.score, scale});
+      }
+    ++scale;
+  }
   return expect;
 }
 
 }  // namespace
 
+// Both scanners (one pass on the stack, one window at a time on per-layer integrals) decide every
+// window as evaluateWindow() does, with its score and scale.
 TEST(Detector, ScanAgreesWithPerWindowEvaluationOnEveryWindow) {
   const Cascade c = randomCascade(1);
   const LayerStack s = randomStack(2);
@@ -85,72 +84,22 @@ TEST(Detector, ScanAgreesWithPerWindowEvaluationOnEveryWindow) {
   ScanParams p;
   p.scaleFactor = 1.25;
   p.threads = 1;
-  ScanStats stats;
-  const Detector det(c);
-  const std::vector<RawHit> hits = det.scan(s, p, &stats);
-  std::size_t windows = 0;
-  const std::vector<RawHit> expect = plainScan(c, in, p, windows);
-  EXPECT_EQ(stats.windows, windows);
-  ASSERT_EQ(hits.size(), expect.size());
-  ASSERT_GT(hits.size(), 10u) << "the test cascade should accept some windows";
-  EXPECT_LT(hits.size(), windows / 2) << "and reject others";
-  for (std::size_t i = 0; i < hits.size(); ++i) {
-    EXPECT_EQ(hits[i].box, expect[i].box);
-    EXPECT_EQ(hits[i].score, expect[i].score);
-  }
-}
-
-// Width stretches: every stretch's windows (width = base width x stretch x scale, the same heights
-// and steps), stretch by stretch, decided as evaluateWindow() decides the stretched box, by both
-// scanners (one pass on the stack, one window at a time on per-layer integrals); {1} = no stretch.
-TEST(Detector, StretchedWindowsAgreeWithPerWindowEvaluationInBothScanners) {
-  const Cascade c = randomCascade(1);
-  const LayerStack s = randomStack(2);
-  const IntegralStack in = integrateFor(c, s);
-  ScanParams p{.scaleFactor = 1.25, .threads = 1, .widthStretches = {1.0, 1.3, 1.6}};
   std::size_t windows = 0;
   const std::vector<RawHit> expect = plainScan(c, in, p, windows);
   const Detector det(c);
-  std::size_t stretched = 0;
-  for (const RawHit& h : expect) stretched += h.stretch > 0;
-  ASSERT_GT(stretched, 10u) << "the test cascade should accept stretched windows";
   for (int path = 0; path < 2; ++path) {
     ScanStats stats;
     const std::vector<RawHit> hits = path == 0 ? det.scan(s, p, &stats) : det.scan(in, p, &stats);
     const std::string what = path == 0 ? "one-pass scanner" : "per-layer scanner";
     EXPECT_EQ(stats.windows, windows) << what;
     ASSERT_EQ(hits.size(), expect.size()) << what;
+    ASSERT_GT(hits.size(), 10u) << "the test cascade should accept some windows";
+    EXPECT_LT(hits.size(), windows / 2) << "and reject others";
     for (std::size_t i = 0; i < hits.size(); ++i) {
       EXPECT_EQ(hits[i].box, expect[i].box) << what << " hit " << i;
       EXPECT_EQ(hits[i].score, expect[i].score) << what << " hit " << i;
       EXPECT_EQ(hits[i].scale, expect[i].scale) << what << " hit " << i;
-      EXPECT_EQ(hits[i].stretch, expect[i].stretch) << what << " hit " << i;
     }
-  }
-  // {1} and no stretch: the same hits, scales and (zero) stretch indices.
-  p.widthStretches = {};
-  const std::vector<RawHit> plain = det.scan(s, p);
-  p.widthStretches = {1.0};
-  const std::vector<RawHit> one = det.scan(s, p);
-  ASSERT_EQ(one.size(), plain.size());
-  for (std::size_t i = 0; i < one.size(); ++i) {
-    EXPECT_EQ(one[i].box, plain[i].box);
-    EXPECT_EQ(one[i].score, plain[i].score);
-    EXPECT_EQ(one[i].scale, plain[i].scale);
-    EXPECT_EQ(one[i].stretch, 0);
-  }
-}
-
-TEST(Detector, WidthStretchesMustBePositiveAndDistinct) {
-  EXPECT_EQ(widthStretchesOf(ScanParams{}), std::vector<double>{1.0});
-  const Detector det(randomCascade(1));
-  const LayerStack s = randomStack(2);
-  for (const std::vector<double>& bad : std::vector<std::vector<double>>{
-           {0.0}, {-1.3}, {1.0, std::nan("")}, {1.0, 1.3, 1.3}, {std::numeric_limits<double>::infinity()}}) {
-    ScanParams p;
-    p.widthStretches = bad;
-    EXPECT_THROW(widthStretchesOf(p), std::invalid_argument);
-    EXPECT_THROW(det.scan(s, p), std::invalid_argument);
   }
 }
 

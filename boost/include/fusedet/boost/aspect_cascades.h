@@ -12,11 +12,6 @@
 // never suppress each other here (their grouping already decided). Output: the kept detections,
 // cascade 0's first, each cascade's in its grouping order. A model without aspect cascades gives
 // exactly groupHits() of its own hits.
-//
-// Width stretches (ScanParams::widthStretches: the same cascade scanned at wider windows) follow
-// the same rule: the hits of each (cascade, stretch) are grouped alone and the lists merged as
-// above in the order cascade 0 stretch 0, cascade 0 stretch 1, ..., cascade 1 stretch 0, ...
-// (kFirstCascadeFirst: a later stretch only adds detections where the earlier ones found none).
 #include <span>
 #include <string>
 #include <vector>
@@ -38,14 +33,12 @@ struct MergedDetections {
   std::vector<std::vector<int>> kept;
 };
 
-// The merge above on already grouped detections (perCascade[k] = list k's: a cascade's, or a
-// (cascade, stretch)'s).
+// The merge above on already grouped detections (perCascade[k] = cascade k's).
 MergedDetections mergeCascadeDetections(const std::vector<std::vector<Detection>>& perCascade, double mergeIou,
                                         GroupParams::AspectMerge order);
 
-// Groups hits[k] (cascade k of cascadesOf(model)), each stretch (RawHit::stretch) alone, and
-// merges them. `fates` (optional) gets per cascade one HitFate per hit (grouping.h), its
-// `detection` an index into the merged output.
+// Groups hits[k] (cascade k of cascadesOf(model)) and merges them. `fates` (optional) gets per
+// cascade one HitFate per hit (grouping.h), its `detection` an index into the merged output.
 // Throws std::invalid_argument when hits has not one entry per cascade.
 std::vector<Detection> groupModelHits(const Cascade& model, const std::vector<std::vector<RawHit>>& hits,
                                       const GroupParams& group, const LayerStack& stack,

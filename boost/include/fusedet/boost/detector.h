@@ -33,13 +33,6 @@ struct ScanParams {
   // OpenCV models use OpenCV's rule (2 pixels of the scaled image below scale 2, else 1).
   double step = 2;
   int threads = 0;  // 0 = all cores (TBB default), 1 = the calling thread only
-  // Our models: window widths scanned, each a factor on the model's own width at the same heights,
-  // positions and steps (window width = base width x stretch x scale), e.g. {1, 1.3, 1.6} for cars
-  // wider than the model's aspect. Features lie in unit-square window coordinates, so a stretched
-  // window scales every feature rectangle in x only (means: independent of the area). Hits carry
-  // the index of their stretch; aspect_cascades.h groups each stretch alone and merges them.
-  // Empty (or {1}) = the model's aspect only, the hits of before; OpenCV models ignore it.
-  std::vector<double> widthStretches;
 };
 
 struct WindowResult {
@@ -51,8 +44,7 @@ struct WindowResult {
 struct RawHit {
   Box box;           // reference pixels
   double score = 0;  // sum of the last stage
-  int scale = 0;     // index of the scale the window was found at (over all stretches)
-  int stretch = 0;   // index into ScanParams::widthStretches (0 when it is empty)
+  int scale = 0;     // index of the scale the window was found at
 };
 
 struct ScanStats {
@@ -65,10 +57,6 @@ struct ScanStats {
 // scanner must agree with). Throws std::invalid_argument for an OpenCV model (use the pyramid).
 WindowResult evaluateWindow(const Cascade& cascade, const IntegralStack& integrals,
                             const Box& window);
-
-// The stretches a scan runs: ScanParams::widthStretches, or {1} when it is empty. Throws
-// std::invalid_argument for a stretch that is not a positive finite number or given twice.
-std::vector<double> widthStretchesOf(const ScanParams& params);
 
 // Layer names a cascade needs from a stack, and the integrals for them.
 IntegralStack integrateFor(const Cascade& cascade, const LayerStack& stack);

@@ -52,11 +52,6 @@ struct GroupParams {
   enum class AspectMerge { kByScore, kFirstCascadeFirst };
   AspectMerge aspectMerge = AspectMerge::kFirstCascadeFirst;
   double aspectMergeIou = 0.5;
-  // Width stretches (ScanParams::widthStretches): false = each stretch's hits grouped alone and the
-  // groups merged as aspect cascades (above); true = one cascade's hits of every stretch grouped as
-  // one list (the rule above links windows of different widths only where all four edges lie
-  // close; a group's box is the average of its members, whatever their widths).
-  bool groupStretchesTogether = false;
 };
 
 // What became of one raw hit (miss_analysis.h asks): the detection it went into, or why none.
@@ -78,8 +73,7 @@ std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams
                                  const std::string& className, const LayerStack& stack,
                                  std::vector<HitFate>* fates = nullptr);
 
-// Scan + group in one call: every cascade of the model (aspect cascades) and every width stretch
-// grouped alone and merged by groupModelHits() (aspect_cascades.h).
+// Scan + group in one call.
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group);
 
