@@ -148,7 +148,7 @@ int runDetect(const DetectOptions& o) {
   const GroupingOfClass grouping = groupingFor(c.className, perClass, group, extent);
 
   const auto t0 = std::chrono::steady_clock::now();
-  PerClassWork work;  // the model's aspect cascades too, merged by the one rule (aspect_cascades.h)
+  PerClassWork work;
   const std::vector<Detection> dets = detectPerClass(detector, stack, scan, group, extent, perClass, &work);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 

@@ -22,7 +22,6 @@
 #include <sstream>
 
 #include "command.h"
-#include "side_view_options.h"
 #include "data_dir.h"
 #include "experiments_peers.h"
 #include "experiments_report.h"
@@ -98,9 +97,6 @@ struct ExperimentOptions {
   // option given on the command line applies to every class instead.
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
-  boosting::TrainingConfig::SideView sideView;  // off by default
-  double aspectMergeIou = 0.5;
-  std::string aspectMerge = "first";
   std::size_t minPositives = 4;
   std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
@@ -358,19 +354,7 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   g.depthLink = o.depthRelative > 0 || o.depthMetres > 0;
   g.depthRelative = o.depthRelative;
   g.depthMetres = o.depthMetres;
-  g.aspectMergeIou = o.aspectMergeIou;
-  g.aspectMerge = o.aspectMerge == "first" ? boosting::GroupParams::AspectMerge::kFirstCascadeFirst
-                                           : boosting::GroupParams::AspectMerge::kByScore;
   return g;
-}
-
-std::string sideViewText(const ExperimentOptions& o) {
-  const boosting::TrainingConfig::SideView& v = o.sideView;
-  if (v.minAspect <= 0) return "off";
-  std::string t = "on: positives w/h >= " + shortNum(v.minAspect) + ", window " + shortNum(v.windowAspect) + ":1";
-  if (v.stageMaxFalseAlarm > 0) t += ", stage max false alarm " + shortNum(v.stageMaxFalseAlarm);
-  if (v.jitterCopies > 0) t += ", " + std::to_string(v.jitterCopies) + " jittered copies";
-  return t + "; merged across cascades (" + o.aspectMerge + ") at IoU > " + shortNum(o.aspectMergeIou);
 }
 
 std::string trainingPositivesText(const ExperimentOptions& o) {
@@ -436,7 +420,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.samples.flipPositives = !o.noMirror;
   c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
   boosting::setReferenceHueRule(c, o.referenceHue);
-  c.sideView = o.sideView;
   return c;
 }
 
@@ -746,7 +729,6 @@ int runExperiments(ExperimentOptions o) {
       {"fold model cache", cache.string()},
       {"jittered copies per positive", std::to_string(o.jitter)},
       {"training positives (--training-positives)", trainingPositivesText(o)},
-      {"side-view cascade (--side-view)", sideViewText(o)},
   };
   // Only when set: reports of default runs stay as they were.
   if (o.noMirror) report.settings["mirrored positives (--no-mirror)"] = "off";
@@ -1363,18 +1345,6 @@ const bool registered = registerCommand(
                    "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
                    "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
                    "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
-      addSideViewOptions(app, o->sideView);
-      app.add_option("--aspect-merge", o->aspectMerge,
-                     "models with aspect cascades: 'first' = the model's own cascade first, an aspect cascade only "
-                     "adds detections where it found none; 'score' = overlapping detections of different cascades "
-                     "keep the higher-scored one")
-          ->check(CLI::IsMember({"score", "first"}))
-          ->capture_default_str();
-      app.add_option("--aspect-merge-iou", o->aspectMergeIou,
-                     "models with aspect cascades: a detection overlapping an already kept one of another of the "
-                     "model's cascades by IoU above this is dropped")
-          ->check(CLI::Range(0.0, 1.0))
-          ->capture_default_str();
       app.add_option("--contrast-normalise", o->contrastNormalise,
                      "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
                      "window's standard deviation of their layer): none, camera (red, green, blue, intensity "

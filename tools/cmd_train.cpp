@@ -17,7 +17,6 @@
 #include <sstream>
 
 #include "command.h"
-#include "side_view_options.h"
 #include "mpi_job.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/chain_evaluation.h"
@@ -51,7 +50,6 @@ struct TrainOptions {
   int validationPart = 0;
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
-  boosting::TrainingConfig::SideView sideView;  // off by default
   bool vanNegative = false;
   std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
   bool ignoredLabelsAsNegatives = false;
@@ -219,7 +217,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.part = o.validationPart;
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
-  c.sideView = o.sideView;
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
@@ -341,12 +338,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   };
   if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
   if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
-  if (c.sideView.minAspect > 0)
-    info.emplace_back("side_view", cascade.aspectCascades.empty()
-                                       ? "none trained (too few positives with w/h >= " + std::to_string(o.sideView.minAspect) + ")"
-                                       : "positives w/h >= " + std::to_string(o.sideView.minAspect) + ", window " +
-                                             std::to_string(cascade.aspectCascades[0].windowWidth) + "x" +
-                                             std::to_string(cascade.aspectCascades[0].windowHeight));
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
                                              std::to_string(report.validationItems) + " items, " +
@@ -359,11 +350,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
               cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), cascade.windowWidth,
               cascade.windowHeight, report.seconds);
   std::printf("stop: %s\n", report.stopReason.c_str());
-  for (const boosting::Cascade& a : cascade.aspectCascades)
-    std::printf("side view: window %dx%d, %zu stages, %zu stumps\n", a.windowWidth, a.windowHeight, a.stages.size(),
-                a.weakCount());
-  if (c.sideView.minAspect > 0 && cascade.aspectCascades.empty())
-    std::printf("side view: none trained (too few positives with w/h >= %g)\n", c.sideView.minAspect);
   if (o.eval) evaluateHeldBack(o, cascade, testIds);
   return 0;
 }
@@ -456,7 +442,6 @@ const bool registered = registerCommand(
                    "store the smallest training positive's height in the model as its minimum detection height "
                    "(\"min_height\"; detection scans from there unless given a minimum size); default: scan from "
                    "the base window");
-      addSideViewOptions(app, o->sideView);
       app.add_flag("--van-negative", o->vanNegative,
                    "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
                    "negative windows on them)");

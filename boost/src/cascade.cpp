@@ -18,7 +18,6 @@ Cascade firstStages(Cascade cascade, std::size_t stages) {
   if (stages == 0) throw std::invalid_argument("firstStages: a cascade keeps at least one stage");
   if (cascade.stages.size() > stages) cascade.stages.resize(stages);
   if (cascade.treeStages.size() > stages) cascade.treeStages.resize(stages);
-  for (Cascade& a : cascade.aspectCascades) a = firstStages(std::move(a), stages);
   return cascade;
 }
 
@@ -72,19 +71,6 @@ void Cascade::validate() const {
       if (!inside) fail("feature " + std::to_string(i) + " rectangle " + std::to_string(r) + " lies outside the " +
                         std::to_string(windowWidth) + "x" + std::to_string(windowHeight) + " window");
       if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
-    }
-  }
-  if (isOpenCv() && !aspectCascades.empty()) fail("an imported OpenCV cascade cannot hold aspect cascades");
-  for (std::size_t i = 0; i < aspectCascades.size(); ++i) {
-    const Cascade& a = aspectCascades[i];
-    const std::string at = "aspect cascade " + std::to_string(i);
-    if (a.className != className) fail(at + " is of class '" + a.className + "', not '" + className + "'");
-    if (a.isOpenCv()) fail(at + " is an OpenCV cascade");
-    if (!a.aspectCascades.empty()) fail(at + " holds aspect cascades itself");
-    try {
-      a.validate();
-    } catch (const std::invalid_argument& e) {
-      fail(at + ": " + e.what());
     }
   }
   const bool trees = hasTrees();

@@ -57,16 +57,8 @@ void TrainingConfig::validate() const {
   if (!(samples.jitterShift >= 0 && samples.jitterShift < 0.5)) bad("jitter shift must be in [0, 0.5)");
   if (!(samples.jitterScale >= 0 && samples.jitterScale < 0.5)) bad("jitter scale must be in [0, 0.5)");
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
-  if (!(sideView.minAspect >= 0)) bad("side view: minimum aspect must be >= 0 (0 = off)");
-  if (sideView.minAspect > 0 && !(sideView.windowAspect > 0)) bad("side view: window aspect must be > 0");
-  if (!(sideView.stageMaxFalseAlarm >= 0 && sideView.stageMaxFalseAlarm < 1))
-    bad("side view: stage max false-alarm rate must be in [0, 1) (0 = the first cascade's)");
-  if (sideView.jitterCopies < 0) bad("side view: jittered copies must be >= 0");
   if (referenceHueRule == ReferenceHueRule::kFixed && !(fixedReferenceHue >= 0 && fixedReferenceHue < 360))
     bad("fixed reference hue must be in [0, 360) degrees");
-  if (sideView.minAspect > 0 && validation.part > 0) bad("a side-view cascade cannot be trained with a validation part");
-  if (!(samples.minPositiveAspect >= 0)) bad("positives' minimum aspect must be >= 0");
-  if (!(samples.windowAspect >= 0)) bad("window aspect must be >= 0 (0 = the positives' median)");
   if (!(samples.scan.scaleFactor > 1)) bad("scan scale factor must be > 1");
   if (!(samples.scan.step > 0)) bad("scan step must be > 0");
 }
@@ -141,43 +133,8 @@ std::vector<StageCountScore> scoreStageCounts(const Cascade& cascade, const Trai
 
 }  // namespace
 
-TrainingConfig withoutSideView(const TrainingConfig& config) {
-  TrainingConfig c = config;
-  c.sideView.minAspect = 0;
-  return c;
-}
-
-TrainingConfig sideViewConfig(const TrainingConfig& config) {
-  TrainingConfig c = withoutSideView(config);
-  c.samples.minPositiveAspect = config.sideView.minAspect;
-  c.samples.windowAspect = config.sideView.windowAspect;
-  if (config.sideView.stageMaxFalseAlarm > 0) c.stage.maxFalseAlarm = config.sideView.stageMaxFalseAlarm;
-  if (config.sideView.jitterCopies > 0) c.samples.jitterCopies = config.sideView.jitterCopies;
-  return c;
-}
-
-namespace {
-Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>& items, ProgressSink& progress,
-                 TrainingReport* reportOut, Collective* job);
-}  // namespace
-
-Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem>& items, ProgressSink& progress,
-                     TrainingReport* report, Collective* job) {
-  config.validate();
-  if (config.sideView.minAspect <= 0) return trainOne(config, items, progress, report, job);
-  Cascade cascade = trainOne(withoutSideView(config), items, progress, report, job);
-  try {
-    cascade.aspectCascades.push_back(trainOne(sideViewConfig(config), items, progress, nullptr, job));
-  } catch (const std::runtime_error&) {
-    // No (or too few) side-view positives in this training set: the first cascade alone.
-  }
-  return cascade;
-}
-
-namespace {
-
-Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>& items,
-                 ProgressSink& progress, TrainingReport* reportOut, Collective* job) {
+Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetItem>& items,
+                     ProgressSink& progress, TrainingReport* reportOut, Collective* job) {
   const auto t0 = Clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
   TrainingConfig config = configIn;
@@ -234,8 +191,8 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
   cascade.contrastNormalised = normalised;
   cascade.referenceHue = refHue;
   cascade.windowHeight = config.samples.baseWindowHeight;
-  const double aspect = config.samples.windowAspect > 0 ? config.samples.windowAspect : stacks.positiveAspect();
-  cascade.windowWidth = std::max(4, static_cast<int>(std::lround(config.samples.baseWindowHeight * aspect)));
+  cascade.windowWidth = std::max(
+      4, static_cast<int>(std::lround(config.samples.baseWindowHeight * stacks.positiveAspect())));
   // Class-specific minimum detection size: the smallest training positive (as labelled).
   double smallest = std::numeric_limits<double>::max();
   for (const DatasetItem& item : train)
@@ -493,7 +450,5 @@ Cascade trainOne(const TrainingConfig& configIn, const std::vector<DatasetItem>&
     throw std::runtime_error("training produced no stage: " + report.stopReason);
   return cascade;
 }
-
-}  // namespace
 
 }  // namespace fusedet::boosting

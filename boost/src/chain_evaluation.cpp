@@ -4,7 +4,6 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/integral_stack.h"
 
 namespace fusedet::boosting {
@@ -56,26 +55,19 @@ std::vector<Detection> detectAndRefine(const std::vector<const Detector*>& chain
                                        ScanStats* stats) {
   if (chain.empty()) throw std::invalid_argument("detectChain: no cascade given");
   const Detector& first = *chain.front();
-  std::vector<std::vector<RawHit>> hits;
-  std::vector<std::vector<HitFate>> fates;
-  std::vector<Detection> dets;
-  if (!first.cascade().aspectCascades.empty()) {
-    if (chain.size() > 1) throw std::invalid_argument(first.cascade().source + ": a model with aspect cascades cannot be AND-combined");
-    hits = scanModel(first, stack, setup.scan, stats);
-    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);
-  } else {
-    hits.push_back(first.scan(stack, setup.scan, stats));
-    for (std::size_t k = 1; k < chain.size() && !hits[0].empty(); ++k) {
-      const Cascade& c = chain[k]->cascade();
-      if (c.isOpenCv()) throw std::invalid_argument(c.source + ": an OpenCV cascade cannot be AND-combined");
-      const IntegralStack integrals = integrateFor(c, stack);
-      std::vector<RawHit> kept;
-      for (const RawHit& h : hits[0])
-        if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
-      hits[0] = std::move(kept);
-    }
-    dets = groupModelHits(first.cascade(), hits, setup.group, stack, &fates);
+  // One list of hits and fates (refineBoxes() takes one per cascade).
+  std::vector<std::vector<RawHit>> hits{first.scan(stack, setup.scan, stats)};
+  std::vector<std::vector<HitFate>> fates(1);
+  for (std::size_t k = 1; k < chain.size() && !hits[0].empty(); ++k) {
+    const Cascade& c = chain[k]->cascade();
+    if (c.isOpenCv()) throw std::invalid_argument(c.source + ": an OpenCV cascade cannot be AND-combined");
+    const IntegralStack integrals = integrateFor(c, stack);
+    std::vector<RawHit> kept;
+    for (const RawHit& h : hits[0])
+      if (evaluateWindow(c, integrals, h.box).accepted) kept.push_back(h);
+    hits[0] = std::move(kept);
   }
+  std::vector<Detection> dets = groupHits(hits[0], setup.group, first.cascade().className, stack, &fates[0]);
   if (groups)
     refineBoxes(dets, hits, fates, stack, setup.laserExtent, setup.boxRegression, groups);
   else

@@ -1,7 +1,5 @@
 #include "fusedet/boost/class_detection.h"
 
-#include "fusedet/boost/aspect_cascades.h"
-
 #include <algorithm>
 #include <iterator>
 
@@ -85,19 +83,16 @@ GroupingOfClass groupingFor(const std::string& className, const std::vector<Clas
 std::vector<Detection> detectPerClass(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                                       const GroupParams& group, const LaserExtentParams& extent,
                                       const std::vector<ClassGrouping>& perClass, PerClassWork* work) {
-  // Every model's cascades, aspect cascades included, merged per model (aspect_cascades.h).
-  const std::vector<std::vector<std::vector<RawHit>>> hits =
-      detector.scanModels(stack, scan, work ? &work->scans : nullptr);
+  const std::vector<std::vector<RawHit>> hits = detector.scan(stack, scan, work ? &work->scans : nullptr);
   if (work) {
     work->rawHits.assign(hits.size(), 0);
     work->detections.clear();
-    for (std::size_t i = 0; i < hits.size(); ++i)
-      for (const std::vector<RawHit>& h : hits[i]) work->rawHits[i] += h.size();
+    for (std::size_t i = 0; i < hits.size(); ++i) work->rawHits[i] = hits[i].size();
   }
   std::vector<Detection> out;
   for (std::size_t i = 0; i < hits.size(); ++i) {
     const GroupingOfClass g = groupingFor(detector.cascade(i).className, perClass, group, extent);
-    std::vector<Detection> d = groupModelHits(detector.cascade(i), hits[i], g.group, stack);
+    std::vector<Detection> d = groupHits(hits[i], g.group, detector.cascade(i).className, stack);
     refineToLaserExtent(d, stack, g.extent);
     if (work) work->detections.push_back(d.size());
     out.insert(out.end(), std::make_move_iterator(d.begin()), std::make_move_iterator(d.end()));

@@ -38,11 +38,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   if (c.minHeightFromPositives) d << "min_height_from_positives\n";
   // Only when set: keys of configurations without them stay as they were.
-  if (c.samples.minPositiveAspect > 0 || c.samples.windowAspect > 0)
-    d << "positives min_aspect " << c.samples.minPositiveAspect << " window_aspect " << c.samples.windowAspect << "\n";
-  if (c.sideView.minAspect > 0)
-    d << "side_view min_aspect " << c.sideView.minAspect << " window_aspect " << c.sideView.windowAspect
-      << " stage_max_fa " << c.sideView.stageMaxFalseAlarm << " jitter " << c.sideView.jitterCopies << "\n";
   if (c.samples.ignoredLabelsAsNegatives) d << "ignored_labels_as_negatives\n";  // only then: keys stay as they were
   if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";  // likewise
   if (c.referenceHueRule == TrainingConfig::ReferenceHueRule::kMostFrequent) d << "reference_hue most_frequent\n";
@@ -88,25 +83,6 @@ std::string trainingKey(const TrainingConfig& config, const std::vector<std::str
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
                     ProgressSink& progress, TrainingReport* report, bool* fromCache, FoldModel* source) {
-  if (config.sideView.minAspect > 0) {
-    // Two cache entries: the first cascade under the key it has without a side view (models
-    // cached before stay usable), the side-view cascade under its own.
-    config.validate();
-    FoldModel baseSource, sideSource;
-    bool baseCached = false, sideCached = false;
-    Cascade cascade = trainOrLoad(withoutSideView(config), items, train, cacheDir, progress, report, &baseCached, &baseSource);
-    try {
-      cascade.aspectCascades.push_back(
-          trainOrLoad(sideViewConfig(config), items, train, cacheDir, progress, nullptr, &sideCached, &sideSource));
-    } catch (const std::runtime_error&) {
-      sideCached = true;  // too few side-view positives: the first cascade alone (as trainCascade())
-    }
-    if (fromCache) *fromCache = baseCached && sideCached;
-    if (source)
-      *source = FoldModel{baseSource.key + "+" + sideSource.key, baseCached && sideCached,
-                          baseSource.trainSeconds + sideSource.trainSeconds};
-    return cascade;
-  }
   std::vector<DatasetItem> subset;
   std::vector<std::string> ids;
   subset.reserve(train.size());

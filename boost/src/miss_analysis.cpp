@@ -6,7 +6,6 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/integral_stack.h"
 #include "fusedet/boost/laser_extent.h"
@@ -99,22 +98,20 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
   const Cascade& cascade = detector.cascade();
   if (cascade.isOpenCv()) throw std::invalid_argument("analyseMisses: " + cascade.source + " is an OpenCV cascade");
   FrameMissAnalysis out;
-  // Every cascade of the model (aspect cascades too, aspect_cascades.h): detections as detectChain().
-  const std::vector<const Cascade*> cascades = cascadesOf(cascade);
-  const std::vector<std::vector<RawHit>> hits = scanModel(detector, stack, setup.scan);
-  std::vector<std::vector<HitFate>> fates;
-  out.detections = groupModelHits(cascade, hits, setup.group, stack, &fates);
-  refineAndVerify(out.detections, hits, fates, stack, setup);  // as detectChain()
+  // Detections as detectChain() (one list of hits and fates: refineAndVerify() takes one per cascade).
+  const std::vector<std::vector<RawHit>> hitLists{detector.scan(stack, setup.scan)};
+  const std::vector<RawHit>& hits = hitLists[0];
+  std::vector<std::vector<HitFate>> fateLists(1);
+  const std::vector<HitFate>& fates = fateLists[0];
+  out.detections = groupHits(hits, setup.group, cascade.className, stack, &fateLists[0]);
+  refineAndVerify(out.detections, hitLists, fateLists, stack, setup);
   out.match = matchDetections(out.detections, labels, match);
 
-  std::vector<std::map<std::tuple<double, double, double, double>, std::size_t>> hitAt(cascades.size());  // window -> raw hit
-  std::vector<std::vector<ScaleWindows>> scales;
-  for (std::size_t k = 0; k < cascades.size(); ++k) {
-    for (std::size_t i = 0; i < hits[k].size(); ++i)
-      hitAt[k].emplace(std::make_tuple(hits[k][i].box.x, hits[k][i].box.y, hits[k][i].box.w, hits[k][i].box.h), i);
-    scales.push_back(windowScales(*cascades[k], stack.width(), stack.height(), setup.scan));
-  }
-  std::vector<std::optional<IntegralStack>> integrals(cascades.size());  // built on the first miss only
+  std::map<std::tuple<double, double, double, double>, std::size_t> hitAt;  // window -> raw hit
+  for (std::size_t i = 0; i < hits.size(); ++i)
+    hitAt.emplace(std::make_tuple(hits[i].box.x, hits[i].box.y, hits[i].box.w, hits[i].box.h), i);
+  const std::vector<ScaleWindows> scales = windowScales(cascade, stack.width(), stack.height(), setup.scan);
+  std::optional<IntegralStack> integrals;  // built on the first miss only
   const int stageCount = static_cast<int>(cascade.stages.size());
 
   for (std::size_t l = 0; l < labels.size(); ++l) {
@@ -130,27 +127,25 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
       if ((d.className.empty() || d.className == match.className) && d.box.h >= match.minDetectionHeight)
         p.bestDetectionIou = std::max(p.bestDetectionIou, iou(d.box, p.box));
     bool taken = false, merged = false, inside = false;
-    for (std::size_t k = 0; k < cascades.size(); ++k) {
-      const Candidates cand = candidatesFor(p.box, scales[k], match.minIou);
-      p.bestWindowIou = std::max(p.bestWindowIou, cand.bestIou);
-      p.candidates += cand.windows.size();
-      if (!integrals[k] && !cand.windows.empty()) integrals[k].emplace(integrateFor(*cascades[k], stack));
-      for (const Box& w : cand.windows) {
-        const WindowResult r = evaluateWindow(*cascades[k], *integrals[k], w);
-        p.deepestStage = std::max(p.deepestStage, r.stagesPassed);
-        if (!r.accepted) continue;
-        const auto it = hitAt[k].find(std::make_tuple(w.x, w.y, w.w, w.h));
-        if (it == hitAt[k].end())
-          throw std::logic_error("analyseMisses: a window evaluateWindow() accepts is not among the scan's hits");
-        ++p.acceptedCandidates;
-        const HitFate& f = fates[k][it->second];
-        p.largestGroup = std::max(p.largestGroup, f.groupSize);
-        if (f.detection >= 0) {
-          const Box& db = out.detections[static_cast<std::size_t>(f.detection)].box;
-          (iou(db, p.box) >= match.minIou ? taken : merged) = true;
-        }
-        inside = inside || f.outcome == HitFate::Outcome::kInsideBiggerGroup;
+    const Candidates cand = candidatesFor(p.box, scales, match.minIou);
+    p.bestWindowIou = cand.bestIou;
+    p.candidates = cand.windows.size();
+    if (!integrals && !cand.windows.empty()) integrals.emplace(integrateFor(cascade, stack));
+    for (const Box& w : cand.windows) {
+      const WindowResult r = evaluateWindow(cascade, *integrals, w);
+      p.deepestStage = std::max(p.deepestStage, r.stagesPassed);
+      if (!r.accepted) continue;
+      const auto it = hitAt.find(std::make_tuple(w.x, w.y, w.w, w.h));
+      if (it == hitAt.end())
+        throw std::logic_error("analyseMisses: a window evaluateWindow() accepts is not among the scan's hits");
+      ++p.acceptedCandidates;
+      const HitFate& f = fates[it->second];
+      p.largestGroup = std::max(p.largestGroup, f.groupSize);
+      if (f.detection >= 0) {
+        const Box& db = out.detections[static_cast<std::size_t>(f.detection)].box;
+        (iou(db, p.box) >= match.minIou ? taken : merged) = true;
       }
+      inside = inside || f.outcome == HitFate::Outcome::kInsideBiggerGroup;
     }
     if (p.bestWindowIou < match.minIou) {
       p.cause = MissCause::kScanGeometry;

@@ -76,6 +76,7 @@ struct RemovedVersion {
 };
 constexpr RemovedVersion kRemovedVersions[] = {
     {3, "soft cascade"},
+    {4, "side-view (aspect) cascades"},
     {5, "tree weak learners"},
 };
 
@@ -97,9 +98,8 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"format\": " << Json(kModelFormatName).dump() << ",\n";
   // Such a model must not load in a build that would ignore the field and decide differently;
   // every other model keeps its bytes.
-  // Version 1 unless a layer is contrast-normalised (2) or it holds
-  // aspect cascades (4).
-  o << "  \"version\": " << (!c.aspectCascades.empty() ? 4 : normalised.empty() ? 1 : 2) << ",\n";
+  // Version 1 unless a layer is contrast-normalised (2).
+  o << "  \"version\": " << (normalised.empty() ? 1 : 2) << ",\n";
   o << "  \"class\": " << Json(c.className).dump() << ",\n";
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
@@ -129,17 +129,7 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
     }
     o << "    ]}" << (s + 1 < c.stages.size() ? ",\n" : "\n");
   }
-  o << "  ]";
-  if (!c.aspectCascades.empty()) {  // optional: absent = none (every file before version 4)
-    o << ",\n  \"aspect_cascades\": [\n";
-    for (std::size_t i = 0; i < c.aspectCascades.size(); ++i) {
-      std::string nested = modelToText(c.aspectCascades[i]);
-      nested.pop_back();  // its final newline
-      o << nested << (i + 1 < c.aspectCascades.size() ? ",\n" : "\n");
-    }
-    o << "  ]";
-  }
-  o << "\n}\n";
+  o << "  ]\n}\n";
   return o.str();
 }
 
@@ -250,19 +240,6 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
       st.stumps.push_back(stump);
     }
     c.stages.push_back(std::move(st));
-  }
-  if (root.contains("aspect_cascades")) {
-    if (version < 4) r.fail("aspect_cascades", "aspect cascades need format version 4, the file says " + std::to_string(version));
-    const Json& aspects = r.array(root, "", "aspect_cascades");
-    if (aspects.empty()) r.fail("aspect_cascades", "empty (leave the key out for none)");
-    for (std::size_t i = 0; i < aspects.size(); ++i) {
-      if (aspects[i].is_object() && aspects[i].contains("aspect_cascades"))  // one level only (no deep recursion)
-        r.fail(Reader::at("aspect_cascades", i), "an aspect cascade cannot hold aspect cascades");
-      // Each is a model object of its own; its messages name the place in this file.
-      Cascade a = modelFromText(aspects[i].dump(), source + ": " + Reader::at("aspect_cascades", i));
-      a.source = source;
-      c.aspectCascades.push_back(std::move(a));
-    }
   }
   try {
     c.validate();

@@ -11,19 +11,14 @@
 
 namespace fusedet::boosting {
 
-bool isClassPositive(const Label& label, const SampleConfig& c) {
+bool isPositiveLabel(const Label& label, const SampleConfig& c) {
   return !label.ignore && label.className == c.className && label.box.h >= c.minPositiveHeight &&
          label.occlusion <= c.maxOcclusion && label.box.w > 0;
 }
 
-bool isPositiveLabel(const Label& label, const SampleConfig& c) {
-  return isClassPositive(label, c) && label.box.w >= c.minPositiveAspect * label.box.h;
-}
-
 bool isIgnoredLabel(const Label& label, const SampleConfig& c) {
   if (label.ignore) return true;
-  // A narrower object of the class is still the class: not ignored, just no positive (below).
-  if (label.className == c.className) return !isClassPositive(label, c);
+  if (label.className == c.className) return !isPositiveLabel(label, c);
   return std::find(c.ignoreClasses.begin(), c.ignoreClasses.end(), label.className) != c.ignoreClasses.end();
 }
 

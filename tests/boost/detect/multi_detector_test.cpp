@@ -12,7 +12,6 @@
 #include <cmath>
 #include <filesystem>
 
-#include "fusedet/boost/aspect_cascades.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/fusion/kitti.h"
@@ -507,48 +506,4 @@ TEST(MultiDetector, ModelsWithoutTheFieldAreNotNormalised) {
   const LayerStack& s = kittiStacks().back();
   const auto a = MultiDetector(models).scan(s, p), b = MultiDetector(explicitFalse).scan(s, p);
   for (std::size_t i = 0; i < models.size(); ++i) expectSameHits(b[i], a[i], models[i].className);
-}
-
-// A model with an aspect cascade (aspect_cascades.h): the one pass scans it beside the model's own
-// cascade exactly as a Detector of it alone would, and detect() gives groupModelHits() of those
-// hits, the rule the evaluation and the miss analysis use. The aspect cascade here is the bundled
-// car model at a 2.4:1 window (its unit-square features are valid at any aspect).
-TEST(MultiDetector, AspectCascadesScanInTheSamePassAndMergeByTheOneRule) {
-  std::vector<Cascade> models = bundledModels();
-  Cascade wide = models[0];
-  wide.windowWidth = 58;
-  models[0].aspectCascades.push_back(wide);
-  const MultiDetector all(models);
-  ScanParams p;
-  p.scaleFactor = 1.1;
-  p.step = 2;
-  p.threads = 2;
-  GroupParams g;
-  std::size_t wideHits = 0;
-  for (const LayerStack& s : kittiStacks()) {
-    std::vector<ScanStats> stats;
-    const auto byModel = all.scanModels(s, p, &stats);
-    ASSERT_EQ(byModel.size(), models.size());
-    ASSERT_EQ(byModel[0].size(), 2u);
-    ASSERT_EQ(byModel[1].size(), 1u);
-    ScanStats refBase, refWide;
-    expectSameHits(byModel[0][0], perClass(models[0], s, p, refBase), "car on " + s.source);
-    expectSameHits(byModel[0][1], perClass(wide, s, p, refWide), "car 2.4:1 on " + s.source);
-    EXPECT_EQ(stats[0].windows, refBase.windows + refWide.windows);
-    expectSameHits(all.scan(s, p)[0], byModel[0][0], "scan() = the model's own cascade");
-    wideHits += byModel[0][1].size();
-    const std::vector<Detection> merged = groupModelHits(models[0], byModel[0], g, s);
-    const std::vector<Detection> viaDetector = groupModelHits(models[0], scanModel(Detector(models[0]), s, p), g, s);
-    std::vector<Detection> fromDetect;
-    for (const Detection& d : detect(all, s, p, g))
-      if (d.className == "car") fromDetect.push_back(d);
-    ASSERT_EQ(fromDetect.size(), merged.size()) << s.source;
-    ASSERT_EQ(viaDetector.size(), merged.size()) << s.source;
-    for (std::size_t i = 0; i < merged.size(); ++i) {
-      EXPECT_EQ(fromDetect[i].box, merged[i].box);
-      EXPECT_EQ(viaDetector[i].box, merged[i].box);
-      EXPECT_EQ(fromDetect[i].score, merged[i].score);
-    }
-  }
-  EXPECT_GT(wideHits, 0u) << "the wide variant should accept some windows";
 }

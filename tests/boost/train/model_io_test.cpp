@@ -117,32 +117,37 @@ TEST(ModelIo, RemovedFormatVersionsAreRefusedWithWhatToDo) {
     int version;
     std::string option, text;
   };
-  const std::string head = "{\n  \"format\": \"fusedet-cascade\",\n  \"version\": ";
-  const std::string body =
-      ",\n  \"class\": \"car\",\n  \"window\": {\"width\":40,\"height\":24},\n"
-      "  \"layers\": [\"intensity\",\"distance\"],\n  \"reference_hue\": null,\n";
+  // A model file as every version wrote it: `fields` after the reference hue, then `stages`, then `tail`.
+  auto file = [](int version, const std::string& fields, const std::string& stages, const std::string& tail) {
+    return "{\n  \"format\": \"fusedet-cascade\",\n  \"version\": " + std::to_string(version) +
+           ",\n  \"class\": \"car\",\n  \"window\": {\"width\":40,\"height\":24},\n"
+           "  \"layers\": [\"intensity\",\"distance\"],\n  \"reference_hue\": null,\n" +
+           fields + "  \"stages\": [\n" + stages + "\n  ]" + tail + "\n}\n";
+  };
   const std::string stumps =
-      "  \"stages\": [\n    {\"threshold\":-0.41,\"stumps\":[\n      {\"type\":\"g\",\"rect\":[0.25,0,0.5,0.5],"
-      "\"layer\":\"distance\",\"threshold\":0.12,\"left\":-0.8,\"right\":0.5}\n    ]}\n  ]\n}\n";
+      "    {\"threshold\":-0.41,\"stumps\":[\n      {\"type\":\"g\",\"rect\":[0.25,0,0.5,0.5],\"layer\":\"distance\","
+      "\"threshold\":0.12,\"left\":-0.8,\"right\":0.5}\n    ]}";
+  const std::string treeStages =
+      "    {\"threshold\":-0.41,\"trees\":[\n      {\"nodes\":[{\"type\":\"g\",\"rect\":[0.25,0,0.5,0.5],"
+      "\"layer\":\"distance\",\"threshold\":0.12,\"left\":0,\"right\":-1}],\"leaves\":[-0.8,0.5]}\n    ]}";
   const std::vector<Removed> removed = {
-      {3, "soft cascade", head + "3" + body + "  \"cascade\": \"soft\",\n" + stumps},
-      {5, "tree weak learners",
-       head + "5" + body +
-           "  \"stages\": [\n    {\"threshold\":-0.41,\"trees\":[\n      {\"nodes\":[{\"type\":\"g\",\"rect\":[0.25,0,0.5,0.5],"
-           "\"layer\":\"distance\",\"threshold\":0.12,\"left\":0,\"right\":-1}],\"leaves\":[-0.8,0.5]}\n    ]}\n  ]\n}\n"},
+      {3, "soft cascade", file(3, "  \"cascade\": \"soft\",\n", stumps, "")},
+      {4, "side-view (aspect) cascades",
+       file(4, "", stumps, ",\n  \"aspect_cascades\": [\n" + file(1, "", stumps, "") + "  ]")},
+      {5, "tree weak learners", file(5, "", treeStages, "")},
   };
   // The same model as version 1 (no removed field) loads: only the version is refused.
-  EXPECT_NO_THROW(modelFromText(head + "1" + body + stumps, "v1.json"));
+  EXPECT_NO_THROW(modelFromText(file(1, "", stumps, ""), "v1.json"));
   const auto dir = std::filesystem::temp_directory_path() / ("fusedet_model_removed_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const Removed& r : removed) {
-    const auto file = dir / ("v" + std::to_string(r.version) + ".json");
-    std::ofstream(file) << r.text;
+    const auto path = dir / ("v" + std::to_string(r.version) + ".json");
+    std::ofstream(path) << r.text;
     try {
-      loadModel(file);
+      loadModel(path);
       ADD_FAILURE() << "version " << r.version << " loaded";
     } catch (const ModelError& e) {
-      const std::string want = file.string() + ": version: model format version " + std::to_string(r.version) + " (" +
+      const std::string want = path.string() + ": version: model format version " + std::to_string(r.version) + " (" +
                                r.option + ") was removed in fusedet 0.1.0";
       EXPECT_EQ(std::string(e.what()).rfind(want, 0), 0u) << e.what();
       EXPECT_NE(std::string(e.what()).find("retrain the model with `fusedet train`"), std::string::npos) << e.what();
@@ -150,17 +155,17 @@ TEST(ModelIo, RemovedFormatVersionsAreRefusedWithWhatToDo) {
   }
   std::filesystem::remove_all(dir);
   // Nor can such a model be made in memory: trees belong to imported OpenCV cascades only.
-  Cascade trees = sample();
-  for (Stage& st : trees.stages) st.stumps.clear();
-  trees.treeStages.assign(2, {Tree{{TreeNode{0, 0.5, 0, -1}}, {-1, 1}}});
+  Cascade treeModel = sample();
+  for (Stage& st : treeModel.stages) st.stumps.clear();
+  treeModel.treeStages.assign(2, {Tree{{TreeNode{0, 0.5, 0, -1}}, {-1, 1}}});
   try {
-    trees.validate();
+    treeModel.validate();
     ADD_FAILURE() << "a tree model of ours validated";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("decision trees are only supported in imported OpenCV cascades"), std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(modelToText(trees), ModelError);
+  EXPECT_THROW(modelToText(treeModel), ModelError);
 }
 
 // The "training" pairs come back as written (the fold-model cache reads "train_seconds" from them);
@@ -271,7 +276,7 @@ TEST(ModelIo, BadContrastNormalisedFieldIsAClearError) {
                 .find("contrast_normalised[2]: layer 'intensity' listed twice"),
             std::string::npos);
   EXPECT_NE(with("{\"intensity\": true}").find("expected an array, got object"), std::string::npos);
-  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 6")).find("unsupported version 6 (this build reads 1 to 4)"),
+  EXPECT_NE(errorOf(replace(good, "\"version\": 2", "\"version\": 6")).find("unsupported version 6 (this build reads 1 to 2)"),
             std::string::npos);
   // Invalid in memory: flags of the wrong size.
   c.contrastNormalised = {true};
@@ -314,95 +319,4 @@ TEST(ModelIo, FuzzedContrastNormalisedFieldNeverCrashes) {
                                       back.contrastNormalised.size() == back.layers.size());
                         }),
             0);
-}
-
-// Aspect cascades (cascade.h, e.g. a side-view car cascade): format version 4, "aspect_cascades"
-// holds model objects of their own; a model without them is written as before.
-namespace {
-Cascade sideView() {
-  Cascade a;
-  a.className = "car";
-  a.windowWidth = 58;
-  a.windowHeight = 24;
-  a.layers = {"distance"};
-  const int f = a.addFeature(Feature{FeatureType::kEdgeVertical, Box{0, 0, 0.5, 1}, 0});
-  a.stages.push_back(Stage{{Stump{f, 2.5, -1, 1}}, 0.25});
-  return a;
-}
-}  // namespace
-
-TEST(ModelIo, AspectCascadesRoundTripAsVersion4) {
-  const std::string plain = modelToText(sample());
-  EXPECT_NE(plain.find("\"version\": 1"), std::string::npos);
-  EXPECT_EQ(plain.find("aspect_cascades"), std::string::npos);
-  Cascade c = sample();
-  c.aspectCascades.push_back(sideView());
-  const std::string text = modelToText(c);
-  EXPECT_NE(text.find("\"version\": 4"), std::string::npos);
-  const Cascade back = modelFromText(text, "m.json");
-  Cascade first = back;
-  first.aspectCascades.clear();
-  EXPECT_EQ(modelToText(first), plain);  // the first cascade read back unchanged
-  ASSERT_EQ(back.aspectCascades.size(), 1u);
-  const Cascade& a = back.aspectCascades[0];
-  EXPECT_EQ(a.windowWidth, 58);
-  EXPECT_EQ(a.windowHeight, 24);
-  EXPECT_EQ(a.layers, std::vector<std::string>{"distance"});
-  ASSERT_EQ(a.stages.size(), 1u);
-  EXPECT_EQ(a.stages[0].threshold, 0.25);
-  EXPECT_EQ(a.stages[0].stumps[0].threshold, 2.5);
-  EXPECT_EQ(a.features[0].type, FeatureType::kEdgeVertical);
-  EXPECT_EQ(a.source, "m.json");
-  EXPECT_EQ(modelToText(back), text);  // stable
-  // Cut to one stage: the aspect cascade is cut alike.
-  EXPECT_EQ(firstStages(back, 1).aspectCascades[0].stages.size(), 1u);
-  EXPECT_EQ(firstStages(back, 1).stages.size(), 1u);
-}
-
-TEST(ModelIo, AspectCascadeErrorsNameTheirPlace) {
-  Cascade c = sample();
-  c.aspectCascades.push_back(sideView());
-  const std::string good = modelToText(c);
-  // Claiming an older version: refused (an older build would detect with the first cascade only).
-  EXPECT_NE(errorOf(replace(good, "\"version\": 4", "\"version\": 3"))
-                .find("m.json: aspect_cascades: aspect cascades need format version 4, the file says 3"),
-            std::string::npos);
-  // A broken nested model: the message names the place in the outer file.
-  const std::size_t nested = good.find("\"aspect_cascades\"");
-  std::string bad = good;
-  bad.replace(bad.find("\"threshold\":2.5", nested), 15, "\"threshold\":\"x\"");
-  EXPECT_NE(errorOf(bad).find("m.json: aspect_cascades[0]: stages[0].stumps[0].threshold: expected a number, got string"),
-            std::string::npos)
-      << errorOf(bad);
-  bad = good;
-  bad.replace(bad.find("\"class\": \"car\"", nested), 14, "\"class\": \"bike\"");
-  EXPECT_NE(errorOf(bad).find("aspect cascade 0 is of class 'bike', not 'car'"), std::string::npos) << errorOf(bad);
-  EXPECT_NE(errorOf(replace(good, "\"aspect_cascades\": [", "\"aspect_cascades\": [], \"x\": [")).find(
-                "aspect_cascades: empty"),
-            std::string::npos);
-  EXPECT_NE(errorOf(replace(good, "\"aspect_cascades\": [", "\"aspect_cascades\": {\"a\": [")).find(
-                "m.json"),
-            std::string::npos);
-  // One level only.
-  Cascade mid = sideView();
-  mid.aspectCascades.push_back(sideView());
-  Cascade deep = sample();
-  deep.aspectCascades.push_back(mid);
-  EXPECT_THROW(deep.validate(), std::invalid_argument);
-  EXPECT_NO_THROW(mid.validate());
-  std::string twoLevels = good;
-  twoLevels.insert(twoLevels.find("\"stages\"", nested), "\"aspect_cascades\": [], ");
-  EXPECT_NE(errorOf(twoLevels).find("m.json: aspect_cascades[0]: an aspect cascade cannot hold aspect cascades"),
-            std::string::npos)
-      << errorOf(twoLevels);
-}
-
-TEST(ModelIo, FuzzedAspectCascadesNeverCrash) {
-  Cascade c = sample();
-  c.aspectCascades.push_back(sideView());
-  const std::string good = modelToText(c);
-  const std::size_t from = good.find("\"aspect_cascades\"");
-  ASSERT_NE(from, std::string::npos);
-  // Edits only in the aspect cascades' part of the file.
-  EXPECT_GT(fuzzSection(good, from, good.size(), 17, "{}[],:\"0-e9.ab4 ", [](const Cascade&) {}), 0);
 }

@@ -86,11 +86,6 @@ struct Cascade {
   // OpenCV tree cascades only: the weak classifiers of stage i are treeStages[i] (instead of
   // stages[i].stumps, which stay empty; stages[i].threshold applies). Empty for every other model.
   std::vector<std::vector<Tree>> treeStages;
-  // Further cascades of the same class, each trained for its own window aspect (e.g. cars seen
-  // from the side, TrainingConfig::sideView) and scanned at it; their detections are merged with
-  // this cascade's by one rule (aspect_cascades.h). Empty for every model without them. An aspect
-  // cascade holds none itself.
-  std::vector<Cascade> aspectCascades;
   std::string source;  // file the model came from (for messages), may be empty
 
   double aspectRatio() const { return double(windowWidth) / double(windowHeight); }
@@ -107,8 +102,7 @@ struct Cascade {
   // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
   // index out of range, hue_distance without a reference hue, OpenCV model without one layer,
   // contrastNormalised not of the layers' size (or set on an OpenCV model),
-  // an aspect cascade of another class, an OpenCV one, or one holding aspect cascades itself, trees
-  // in one of our models, a tree stage count other than the stage count, a stage mixing stumps
+  // trees in one of our models, a tree stage count other than the stage count, a stage mixing stumps
   // and trees, a tree whose children do not follow their parent.
   void validate() const;
 };
@@ -116,7 +110,7 @@ struct Cascade {
 // The cascade's first `stages` stages (all of them when it has no more). Training adds stages in
 // order, each from the cascade before it with its own per-stage seed (cascade_trainer.h), so this
 // is the cascade training with max_stages = `stages` gives: a stage-count sweep can cut trained
-// models instead of training again. Aspect cascades are cut alike. Throws std::invalid_argument for 0.
+// models instead of training again. Throws std::invalid_argument for 0.
 Cascade firstStages(Cascade cascade, std::size_t stages);
 
 }  // namespace fusedet::boosting

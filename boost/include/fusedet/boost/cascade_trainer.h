@@ -53,20 +53,6 @@ struct TrainingConfig {
   // Store the smallest training positive's height as the model's minimum detection height
   // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
   bool minHeightFromPositives = false;
-  // Side-view cascade (Cascade::aspectCascades): minAspect > 0 = after the cascade (trained
-  // exactly as without this), a second one of the class whose positives are only the labels with
-  // w/h >= minAspect (mirrored and jittered alike), window windowAspect:1 at the same height,
-  // negatives as usual (no window with IoU >= max_negative_iou on any object of the class);
-  // stageMaxFalseAlarm > 0 replaces stage.maxFalseAlarm for it (fewer wide positives make short
-  // stages: a lower rate makes each stage longer), jitterCopies > 0 samples.jitterCopies (more
-  // copies of the few wide positives). A training set without such positives (too few
-  // to train) gives the first cascade alone. Off by default; not with a validation part.
-  struct SideView {
-    double minAspect = 0;
-    double windowAspect = 2.4;
-    double stageMaxFalseAlarm = 0;
-    int jitterCopies = 0;
-  } sideView;
   // Which labels the caller made training positives before the items reached the trainer
   // (class_rules.h: toString(TrainingPositives), labels mapped by trainingLabels() with
   // trainingMatchConfig()); "" = moderate, the evaluation positives. The trainer does not apply it
@@ -151,8 +137,7 @@ class NullProgress : public ProgressSink {
   void onProgress(const ProgressEvent&) override {}
 };
 
-// Trains (with TrainingConfig::sideView: both cascades, `report` of the first); throws
-// std::invalid_argument for a bad config and std::runtime_error when the data has
+// Trains; throws std::invalid_argument for a bad config and std::runtime_error when the data has
 // no positives of the class or lacks a selected layer (the message names the item).
 //
 // With `job` (collective.h) training is sharded over its ranks, each calling this with the same
@@ -164,10 +149,6 @@ class NullProgress : public ProgressSink {
 Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem>& train,
                      ProgressSink& progress, TrainingReport* report = nullptr, Collective* job = nullptr);
 
-// `config` without the side view (the first cascade's training), and the side-view cascade's own
-// training config (positives w/h >= sideView.minAspect, window sideView.windowAspect:1).
-TrainingConfig withoutSideView(const TrainingConfig& config);
-TrainingConfig sideViewConfig(const TrainingConfig& config);
 // Reference hue of config.className's positives in `items` (reference_hue.h), from their hue
 // layer: their distinctive hue, or with mostFrequent the paper's most frequent one. Throws
 // std::runtime_error when no positive has hue values.

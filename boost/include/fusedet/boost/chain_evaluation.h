@@ -42,8 +42,8 @@ std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, co
 // The box part of what follows grouping (refineAndVerify() below adds the verifier; detectPerClass(),
 // what fusedetd runs, applies the laser extent only: no model holds a fit, box_regression.h):
 // the laser extent (laser_extent.h), then `regression` (identity when not fitted) on grouped
-// detections. hits[k] / fates[k]: cascade k's raw hits and what became of them (grouping.h,
-// aspect_cascades.h; a fate's `detection` indexes `detections`). `groups` (optional) gets each
+// detections. hits[k] / fates[k]: cascade k's raw hits and what became of them (grouping.h; a
+// fate's `detection` indexes `detections`). `groups` (optional) gets each
 // detection's GroupedBox (its box before `regression`).
 void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vector<RawHit>>& hits,
                  const std::vector<std::vector<HitFate>>& fates, const LayerStack& stack,

@@ -81,7 +81,7 @@ GroupingOfClass groupingFor(const std::string& className, const std::vector<Clas
 // Work done by detectPerClass(), per model (index = model order).
 struct PerClassWork {
   std::vector<ScanStats> scans;
-  std::vector<std::size_t> rawHits;     // over the model's cascades, aspect cascades included
+  std::vector<std::size_t> rawHits;     // per model
   std::vector<std::size_t> detections;  // the output holds model 0's first, then model 1's, ...
 };
 

@@ -44,14 +44,6 @@ struct GroupParams {
   double depthMetres = 0;
   int depthMinCells = 6;
   double iouThreshold = 0.5;   // kNms
-  // A model with aspect cascades (aspect_cascades.h): a detection overlapping an already kept one
-  // of another of the model's cascades by IoU > aspectMergeIou is dropped; kept in the order of
-  // the cascades, each by score (kFirstCascadeFirst: an aspect cascade only adds detections where
-  // the model's own found none; measured as good as or better than kByScore for car, docs/results)
-  // or of score (kByScore).
-  enum class AspectMerge { kByScore, kFirstCascadeFirst };
-  AspectMerge aspectMerge = AspectMerge::kFirstCascadeFirst;
-  double aspectMergeIou = 0.5;
 };
 
 // What became of one raw hit (miss_analysis.h asks): the detection it went into, or why none.

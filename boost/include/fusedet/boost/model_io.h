@@ -19,8 +19,7 @@
 //         ...
 //       ]},
 //       ...
-//     ],
-//     "aspect_cascades": [ {a model object as above}, ... ]   (version 4; optional; absent = none)
+//     ]
 //   }
 
 #include <filesystem>
@@ -34,14 +33,13 @@
 namespace fusedet::boosting {
 
 // Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
-// standard deviation, feature.h); version 4 adds
-// "aspect_cascades" (cascade.h: further cascades of the class at their own window aspect, e.g.
-// side views; an older build would detect with the first cascade only). Models without them are
-// still written as version 1, byte for byte as before. Every version loads.
+// standard deviation, feature.h). Models without them are still written as version 1, byte for
+// byte as before.
 // Versions of options that measured no gain across drives were removed with them (issue 29):
 // loading such a file fails with a ModelError naming the version, the option and what to do
-// (retrain with `fusedet train`): versions 3 (soft cascade) and 5 (tree weak learners).
-inline constexpr int kModelFormatVersion = 4;
+// (retrain with `fusedet train`): versions 3 (soft cascade), 4 (side-view (aspect) cascades) and 5
+// (tree weak learners).
+inline constexpr int kModelFormatVersion = 2;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.

@@ -37,19 +37,13 @@ class MultiDetector {
   // that the stack lacks, std::invalid_argument for a scale factor <= 1.
   std::vector<std::vector<RawHit>> scan(const LayerStack& stack, const ScanParams& params,
                                         std::vector<ScanStats>* stats = nullptr) const;
-  // The same pass over every model's cascades, aspect cascades included (aspect_cascades.h):
-  // result[i][k] = hits of cascade k of cascadesOf(model i); stats per model summed over them.
-  // scan() returns result[i][0] of each model.
-  std::vector<std::vector<std::vector<RawHit>>> scanModels(const LayerStack& stack, const ScanParams& params,
-                                                           std::vector<ScanStats>* stats = nullptr) const;
 
  private:
   std::vector<Cascade> cascades_;
 };
 
 // Scan + group for every model: the detections of model 0, then model 1, ... (each model's
-// className on its detections; grouping.h's rules per model, merged over its aspect cascades by
-// groupModelHits(), aspect_cascades.h).
+// className on its detections; grouping.h's rules per model).
 std::vector<Detection> detect(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group);
 

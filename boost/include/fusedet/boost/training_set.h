@@ -51,12 +51,6 @@ struct SampleConfig {
   // are not used (their labels are background).
   bool ignoredLabelsAsNegatives = false;
   int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
-  // Side-view (aspect) cascades (TrainingConfig::sideView): only labels with w/h >= minPositiveAspect
-  // become positives (0 = every aspect); the class's other labels stay what they are for the
-  // negatives (no window with IoU >= maxNegativeIou on them is a negative). windowAspect > 0 sets
-  // the window's w/h instead of the positives' median.
-  double minPositiveAspect = 0;
-  double windowAspect = 0;
   ScanParams scan;            // windows scanned for negatives (scales, step)
 };
 
@@ -67,8 +61,6 @@ struct Sample {
 
 // Does `label` become a positive of `config.className`?
 bool isPositiveLabel(const Label& label, const SampleConfig& config);
-// Does `label` meet the class's positive rule, whatever its aspect (minPositiveAspect ignored)?
-bool isClassPositive(const Label& label, const SampleConfig& config);
 // Is `label` neither a positive nor background for config.className (see SampleConfig)?
 bool isIgnoredLabel(const Label& label, const SampleConfig& config);
 // The classes KITTI's devkit ignores next to `className` ("van" for "car"); empty for others.
