@@ -83,7 +83,6 @@ struct ExperimentOptions {
   std::string grouping = "opencv";  // opencv | nms (boosting::GroupParams)
   double nmsIou = 0.5;
   int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
-  double depthRelative = 0, depthMetres = 0;   // GroupParams::depthLink when either is > 0
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
   bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
   double boxFitLambda = boosting::BoxFitParams{}.lambda;
@@ -351,9 +350,6 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   g.iouThreshold = o.nmsIou;
   g.smallHeight = o.smallHeight;
   g.smallMinNeighbors = o.smallMinNeighbors;
-  g.depthLink = o.depthRelative > 0 || o.depthMetres > 0;
-  g.depthRelative = o.depthRelative;
-  g.depthMetres = o.depthMetres;
   return g;
 }
 
@@ -374,9 +370,6 @@ std::string groupingText(const ExperimentOptions& o) {
   std::string t = "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors);
   if (o.smallHeight > 0)
     t += " (" + std::to_string(o.smallMinNeighbors) + " for groups lower than " + std::to_string(o.smallHeight) + " px)";
-  if (o.depthRelative > 0 || o.depthMetres > 0)
-    t += "; hits linked only at the same laser depth (within " + shortNum(o.depthRelative * 100) + " % + " +
-         shortNum(o.depthMetres) + " m)";
   return t;
 }
 
@@ -1284,18 +1277,6 @@ const bool registered = registerCommand(
       app.add_option("--small-min-neighbors", o->smallMinNeighbors,
                      "--grouping opencv with --small-height: hits a group lower than that height needs (more than)")
           ->check(CLI::Range(0, 1000))
-          ->capture_default_str();
-      app.add_option("--depth-link", o->depthRelative,
-                     "--grouping opencv: link two raw hits only if their laser depths (median distance of the valid "
-                     "cells of each window's lower middle) differ by at most this fraction of the nearer one (plus "
-                     "--depth-link-metres); hits without laser cells link as before; 0 = off (boost/grouping.h "
-                     "GroupParams::depthLink)")
-          ->check(CLI::Range(0.0, 10.0))
-          ->capture_default_str();
-      app.add_option("--depth-link-metres", o->depthMetres,
-                     "--grouping opencv: depth-aware linking (as --depth-link) with this many metres of tolerance "
-                     "added; 0 = none")
-          ->check(CLI::Range(0.0, 1000.0))
           ->capture_default_str();
       app.add_flag("--laser-extent", o->laserExtent,
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "

@@ -56,9 +56,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
       << v.detection.group.eps << " " << v.detection.group.iouThreshold;
     if (v.detection.group.smallHeight > 0)  // only then: earlier keys stay as they were
       d << " small " << v.detection.group.smallHeight << " " << v.detection.group.smallMinNeighbors;
-    if (v.detection.group.depthLink)  // only then: earlier keys stay as they were
-      d << " depth " << v.detection.group.depthRelative << " " << v.detection.group.depthMetres << " "
-        << v.detection.group.depthMinCells;
     d << " match " << v.match.className << " "
       << v.match.minIou << " " << v.match.minHeight << " " << v.match.maxOcclusion << " " << v.match.maxTruncation
       << " " << v.match.minDetectionHeight << " aliases " << joined(v.match.aliasClasses) << " neighbours "

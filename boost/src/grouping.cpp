@@ -2,11 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <numeric>
-#include <optional>
-
-#include "fusedet/boost/laser_cells.h"
 
 namespace fusedet::boosting {
 
@@ -33,16 +29,6 @@ int find(std::vector<int>& parent, int i) {
     i = parent[static_cast<std::size_t>(i)];
   }
   return i;
-}
-
-// Each hit's laser depth (GroupParams::depthLink), NaN where it has none.
-std::vector<double> hitDepths(std::span<const RawHit> hits, const GroupParams& p, const LayerStack& stack) {
-  const LaserCells cells(stack);
-  std::vector<double> depth(hits.size(), std::numeric_limits<double>::quiet_NaN());
-  if (cells.empty()) return depth;
-  for (std::size_t i = 0; i < hits.size(); ++i)
-    if (const std::optional<double> d = cells.coreDepth(hits[i].box, p.depthMinCells)) depth[i] = *d;
-  return depth;
 }
 
 Detection makeDetection(const Box& box, double score, const std::string& className, const LayerStack& stack) {
@@ -78,20 +64,13 @@ std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupPara
   std::vector<int> byX(hits.size());
   std::iota(byX.begin(), byX.end(), 0);
   std::stable_sort(byX.begin(), byX.end(), [&](int a, int b) { return r[std::size_t(a)].x < r[std::size_t(b)].x; });
-  const std::vector<double> depth = p.depthLink ? hitDepths(hits, p, stack) : std::vector<double>();
-  const auto sameDepth = [&](int a, int b) {
-    if (depth.empty()) return true;
-    const double da = depth[std::size_t(a)], db = depth[std::size_t(b)];
-    if (std::isnan(da) || std::isnan(db)) return true;  // no laser on one of them: the edge rule alone
-    return std::abs(da - db) <= p.depthRelative * std::min(da, db) + p.depthMetres;
-  };
   for (std::size_t a = 0; a < byX.size(); ++a) {
     const IRect& ra = r[static_cast<std::size_t>(byX[a])];
     const double reach = std::max(0.0, p.eps) * (std::max(ra.w, 0) + std::max(ra.h, 0)) * 0.5;
     for (std::size_t b = a + 1; b < byX.size(); ++b) {
       const IRect& rb = r[static_cast<std::size_t>(byX[b])];
       if (rb.x - ra.x > reach) break;
-      if (similar(ra, rb, p.eps) && sameDepth(byX[a], byX[b])) {
+      if (similar(ra, rb, p.eps)) {
         const int i = find(parent, byX[a]), j = find(parent, byX[b]);
         if (i != j) parent[static_cast<std::size_t>(std::max(i, j))] = std::min(i, j);
       }

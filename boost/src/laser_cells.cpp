@@ -39,11 +39,6 @@ LaserCells::Place LaserCells::place(const Box& box) const {
   return p;
 }
 
-std::optional<double> LaserCells::coreDepth(const Box& box, int minCells) const {
-  if (empty()) return std::nullopt;
-  return coreDepth(place(box), minCells);
-}
-
 std::optional<double> LaserCells::coreDepth(const Place& at, int minCells) const {
   if (empty()) return std::nullopt;
   std::vector<float> core;

@@ -4,8 +4,7 @@
 //    min height) / 2 of each other are linked, linked sets form groups (transitively), a group
 //    becomes its average rectangle if it has more than minNeighbors members, and groups that sit
 //    inside a bigger, better supported group are dropped. Score = members in the group.
-//    minNeighbors <= 0 returns every hit unchanged (OpenCV's behaviour). Optionally
-//    (GroupParams::depthLink) only hits at the same laser depth are linked.
+//    minNeighbors <= 0 returns every hit unchanged (OpenCV's behaviour).
 //  - kNms: greedy non-maximum suppression by score (the last stage's sum): a hit is dropped when it
 //    overlaps an already kept one with IoU > iouThreshold. Score = the hit's score.
 // Output order is deterministic: groups by their first hit, NMS by descending score then index.
@@ -30,19 +29,6 @@ struct GroupParams {
   int smallHeight = 0;
   int smallMinNeighbors = 1;
   double eps = 0.2;            // kOpenCv (OpenCV's GROUP_EPS)
-  // kOpenCv, depth-aware linking (off by default = cv::groupRectangles' rule): two hits are linked
-  // only if, besides the edge rule, their laser depths agree,
-  //   |d_a - d_b| <= depthRelative x min(d_a, d_b) + depthMetres,
-  // where a hit's depth is the median distance of the valid cells in its box's core (the lower
-  // middle, laser_cells.h - as the laser-extent refinement reads a box). A hit with fewer than
-  // depthMinCells valid cells, or a stack without a distance layer, has no depth: it links by the
-  // edge rule alone. Why: windows on two neighbouring cars, or on a car and the wall behind it,
-  // are otherwise linked transitively and averaged into one box that hits neither.
-  // Measured for car (docs/results "Depth-aware grouping"): a tie across drives, so it is off.
-  bool depthLink = false;
-  double depthRelative = 0.1;
-  double depthMetres = 0;
-  int depthMinCells = 6;
   double iouThreshold = 0.5;   // kNms
 };
 

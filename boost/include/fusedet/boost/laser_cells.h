@@ -1,8 +1,7 @@
 #pragma once
 // A stack's `distance` layer read in boxes given in the stack's reference pixels: the one place
-// that says which laser cells a box covers and what distance the box is at. The laser-extent
-// refinement (laser_extent.h: reference distance, column walk, laserRows) and depth-aware grouping
-// (grouping.h: a hit's depth) both read boxes through it.
+// that says which laser cells a box covers and what distance the box is at, e.g. for the
+// laser-extent refinement (laser_extent.h: reference distance, column walk, laserRows).
 //
 // A cell is valid when the layer's mask (if any) is non-zero there and its distance is finite and
 // > 0. A box maps onto the cells through unit coordinates (the layer has its own resolution). Its
@@ -50,7 +49,6 @@ class LaserCells {
 
   // Median distance of the valid cells of the box's core; nullopt with fewer than
   // max(1, minCells) of them (no laser on the box) or an empty layer.
-  std::optional<double> coreDepth(const Box& box, int minCells) const;
   std::optional<double> coreDepth(const Place& at, int minCells) const;
 
  private:
