@@ -82,7 +82,6 @@ struct ExperimentOptions {
   int minNeighbors = 3;
   std::string grouping = "opencv";  // opencv | nms (boosting::GroupParams)
   double nmsIou = 0.5;
-  int smallHeight = 0, smallMinNeighbors = 1;  // GroupParams: fewer neighbours for low groups
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
   bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
   double boxFitLambda = boosting::BoxFitParams{}.lambda;
@@ -348,8 +347,6 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   g.method = o.grouping == "nms" ? boosting::GroupParams::Method::kNms : boosting::GroupParams::Method::kOpenCv;
   g.minNeighbors = o.minNeighbors;
   g.iouThreshold = o.nmsIou;
-  g.smallHeight = o.smallHeight;
-  g.smallMinNeighbors = o.smallMinNeighbors;
   return g;
 }
 
@@ -368,8 +365,6 @@ std::string trainingPositivesText(const ExperimentOptions& o) {
 std::string groupingText(const ExperimentOptions& o) {
   if (o.grouping == "nms") return "non-maximum suppression by last stage sum, IoU > " + shortNum(o.nmsIou);
   std::string t = "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors);
-  if (o.smallHeight > 0)
-    t += " (" + std::to_string(o.smallMinNeighbors) + " for groups lower than " + std::to_string(o.smallHeight) + " px)";
   return t;
 }
 
@@ -1268,15 +1263,6 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_option("--nms-iou", o->nmsIou, "--grouping nms: a hit overlapping a kept one with IoU above this is dropped")
           ->check(CLI::Range(0.0, 1.0))
-          ->capture_default_str();
-      app.add_option("--small-height", o->smallHeight,
-                     "--grouping opencv: groups lower than this many pixels need more than --small-min-neighbors "
-                     "hits instead of --min-neighbors (a small object is covered by fewer scanned windows); 0 = off")
-          ->check(CLI::Range(0, 100000))
-          ->capture_default_str();
-      app.add_option("--small-min-neighbors", o->smallMinNeighbors,
-                     "--grouping opencv with --small-height: hits a group lower than that height needs (more than)")
-          ->check(CLI::Range(0, 1000))
           ->capture_default_str();
       app.add_flag("--laser-extent", o->laserExtent,
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "

@@ -54,8 +54,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
       << v.detection.scan.minWidth << " " << v.detection.scan.minHeight << " group "
       << static_cast<int>(v.detection.group.method) << " " << v.detection.group.minNeighbors << " "
       << v.detection.group.eps << " " << v.detection.group.iouThreshold;
-    if (v.detection.group.smallHeight > 0)  // only then: earlier keys stay as they were
-      d << " small " << v.detection.group.smallHeight << " " << v.detection.group.smallMinNeighbors;
     d << " match " << v.match.className << " "
       << v.match.minIou << " " << v.match.minHeight << " " << v.match.maxOcclusion << " " << v.match.maxTruncation
       << " " << v.match.minDetectionHeight << " aliases " << joined(v.match.aliasClasses) << " neighbours "

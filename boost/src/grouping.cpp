@@ -99,24 +99,19 @@ std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupPara
     auto rnd = [s](long long v) { return static_cast<int>(std::lrintf(static_cast<float>(v) * s)); };
     avg[c] = {rnd(sums[c][0]), rnd(sums[c][1]), rnd(sums[c][2]), rnd(sums[c][3])};
   }
-  // Members a group needs more than: minNeighbors, or smallMinNeighbors for groups lower than
-  // smallHeight (off by default, which is cv::groupRectangles' rule).
-  const auto needs = [&](std::size_t c) {
-    return p.smallHeight > 0 && avg[c].h < p.smallHeight ? p.smallMinNeighbors : p.minNeighbors;
-  };
   std::vector<HitFate> classFate(avg.size());
   for (std::size_t i = 0; i < avg.size(); ++i) {
     const IRect& r1 = avg[i];
     const int n1 = count[i];
     classFate[i].groupSize = n1;
-    if (n1 <= needs(i)) {
+    if (n1 <= p.minNeighbors) {
       classFate[i].outcome = HitFate::Outcome::kTooFewNeighbours;
       continue;
     }
     bool inside = false;
     for (std::size_t j = 0; j < avg.size() && !inside; ++j) {
       const int n2 = count[j];
-      if (j == i || n2 <= needs(j)) continue;
+      if (j == i || n2 <= p.minNeighbors) continue;
       const IRect& r2 = avg[j];
       const int dx = static_cast<int>(std::lrint(r2.w * p.eps)), dy = static_cast<int>(std::lrint(r2.h * p.eps));
       inside = r1.x >= r2.x - dx && r1.y >= r2.y - dy && r1.x + r1.w <= r2.x + r2.w + dx &&

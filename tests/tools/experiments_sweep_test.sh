@@ -27,13 +27,6 @@ misses=$(echo "$all" | cut -d' ' -f3)
 grep -q "^### car / all: $misses of [0-9]* positives missed" "$work/out/report.md" \
   || { grep '^### car' "$work/out/report.md" >&2; fail "miss analysis does not count the all row's $misses misses"; }
 grep -q '"miss_analysis"' "$work/out/results.json" || fail "no miss_analysis in results.json"
-# --small-height: every group "small" and needing what --min-neighbors asks changes nothing; needing
-# more than 1 member is --min-neighbors 1.
-q() { "$fusedet" experiments --quick --data "$data" --dataset-cache "$quick/dataset" --model-cache "$quick/fold-models" \
-        --classes car --configs all --no-peers --no-miss-analysis --learning none "$@" | grep -E '^car +all +F' | counts; }
-[ "$(q --small-height 100000 --small-min-neighbors 3 --out "$work/s3")" = "$all" ] || fail "--small-min-neighbors 3 for every group differs from the default"
-[ "$(q --small-height 100000 --small-min-neighbors 1 --out "$work/s1")" = "$(q --min-neighbors 1 --out "$work/n1")" ] \
-  || fail "--small-min-neighbors 1 for every group differs from --min-neighbors 1"
 rc=0
 "$fusedet" experiments --data "$data" --out "$work/bad" --class-stages person >"$work/bad.txt" 2>&1 || rc=$?
 [ "$rc" -eq 1 ] || { cat "$work/bad.txt" >&2; fail "--class-stages person: exit status $rc, expected 1 (an error, no crash)"; }

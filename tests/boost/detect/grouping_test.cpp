@@ -87,28 +87,6 @@ TEST(Grouping, NmsKeepsTheBestOfOverlappingHits) {
   EXPECT_DOUBLE_EQ(d[2].unitBox.h, 0.2);
 }
 
-TEST(Grouping, SmallGroupsMayNeedFewerNeighbours) {
-  LayerStack stack(400, 200);
-  // A group of two 30 px hits and a group of two 80 px hits, far apart.
-  const std::vector<RawHit> hits = {{Box{10, 10, 30, 30}, 1, 0}, {Box{11, 10, 30, 30}, 1, 0},
-                                    {Box{200, 50, 80, 80}, 1, 0}, {Box{202, 51, 80, 80}, 1, 0}};
-  GroupParams p;
-  p.minNeighbors = 3;
-  EXPECT_TRUE(groupHits(hits, p, "car", stack).empty());  // both need 4 members
-  p.smallHeight = 40;  // groups lower than 40 px need more than 1 member
-  p.smallMinNeighbors = 1;
-  const auto d = groupHits(hits, p, "car", stack);
-  ASSERT_EQ(d.size(), 1u);
-  EXPECT_EQ(d[0].box, (Box{10, 10, 30, 30}));  // mean x 10.5 rounds to even, as OpenCV's cvRound
-  EXPECT_EQ(d[0].score, 2);
-  p.smallHeight = 81;  // now the 80 px group is "small" too
-  EXPECT_EQ(groupHits(hits, p, "car", stack).size(), 2u);
-  // Off (smallHeight 0) is cv::groupRectangles' rule whatever smallMinNeighbors says.
-  p.smallHeight = 0;
-  p.smallMinNeighbors = 0;
-  EXPECT_TRUE(groupHits(hits, p, "car", stack).empty());
-}
-
 TEST(CvIntegrals, SumSquaredAndTiltedEqualCvIntegral) {
   for (const cv::Size size : {cv::Size(1, 1), cv::Size(7, 3), cv::Size(31, 47), cv::Size(640, 480)}) {
     cv::Mat img(size, CV_8U);

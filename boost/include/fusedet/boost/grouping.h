@@ -23,11 +23,6 @@ struct GroupParams {
   enum class Method { kOpenCv, kNms };
   Method method = Method::kOpenCv;
   int minNeighbors = 3;        // kOpenCv
-  // kOpenCv: groups whose box is lower than smallHeight pixels need more than smallMinNeighbors
-  // members instead (a small object is covered by fewer scanned windows: no smaller scales lie
-  // below the minimum size). smallHeight 0 = off (cv::groupRectangles' rule).
-  int smallHeight = 0;
-  int smallMinNeighbors = 1;
   double eps = 0.2;            // kOpenCv (OpenCV's GROUP_EPS)
   double iouThreshold = 0.5;   // kNms
 };
