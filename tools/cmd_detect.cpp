@@ -41,8 +41,6 @@ struct DetectOptions {
   bool laserExtent = false;         // given: on for every class
   bool classDetection = true;       // a class with settings of its own gets them (class_detection.h)
   std::string minSize, maxSize;
-  std::string group = "opencv";
-  double iou = 0.5;
   double step = 2;
   int threads = 0;
 };
@@ -136,9 +134,6 @@ int runDetect(const DetectOptions& o) {
   if (!o.maxSize.empty()) std::tie(scan.maxWidth, scan.maxHeight) = parseSize(o.maxSize, "--max-size");
   GroupParams group;
   group.minNeighbors = o.minNeighbors.value_or(group.minNeighbors);
-  group.iouThreshold = o.iou;
-  if (o.group == "nms") group.method = GroupParams::Method::kNms;
-  else if (o.group != "opencv") throw std::runtime_error("--group must be opencv or nms, not '" + o.group + "'");
   LaserExtentParams extent;
   extent.enabled = o.laserExtent;
   // The model's class gets its own min neighbours / laser extent (car) unless the option was given.
@@ -156,11 +151,8 @@ int runDetect(const DetectOptions& o) {
               o.model.filename().string().c_str(), (o.image.empty() ? o.stack : o.image).string().c_str(),
               stack.width(), stack.height(), work.scans[0].windows, work.scans[0].scales, work.rawHits[0], dets.size(),
               ms);
-  const std::string method = group.method == GroupParams::Method::kNms
-                                 ? "nms (IoU " + std::to_string(group.iouThreshold).substr(0, 4) + ")"
-                                 : "opencv, " + std::to_string(grouping.group.minNeighbors) + " neighbours";
-  std::printf("  %s grouping: %s, laser extent %s\n", grouping.own ? "class's own" : "general", method.c_str(),
-              grouping.extent.enabled ? "on" : "off");
+  std::printf("  %s grouping: %d neighbours, laser extent %s\n", grouping.own ? "class's own" : "general",
+              grouping.group.minNeighbors, grouping.extent.enabled ? "on" : "off");
   for (const Detection& d : dets)
     std::printf("  %s score %.4g  x %.0f y %.0f w %.0f h %.0f\n", d.className.c_str(), d.score, d.box.x, d.box.y,
                 d.box.w, d.box.h);
@@ -225,13 +217,6 @@ const bool registered = registerCommand(
                      "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
                      "smallest training positive, in models that have one - else its base window)");
       app.add_option("--max-size", o->maxSize, "largest window WxH in image pixels (default: the whole image)");
-      app.add_option("--group", o->group,
-                     "grouping of raw hits: opencv (cv::groupRectangles' rule; score = hits in the group) or nms "
-                     "(score-based non-maximum suppression; score = last stage sum)")
-          ->capture_default_str();
-      app.add_option("--iou", o->iou, "--group nms: suppress a hit overlapping a kept one with IoU above this")
-          ->capture_default_str()
-          ->check(CLI::Range(0.0, 1.0));
       app.add_option("--step", o->step,
                      "our models: position step in base-window pixels, scaled with the window (OpenCV models use "
                      "OpenCV's step)")
@@ -244,7 +229,7 @@ const bool registered = registerCommand(
           "Examples:\n"
           "  fusedet detect -m /usr/share/opencv4/haarcascades/haarcascade_frontalface_default.xml \\\n"
           "      -i /usr/share/doc/opencv-doc/examples/data/messi5.jpg --draw faces.png --json faces.json\n"
-          "  fusedet detect -m models/car.json --stack data/kitti_set --item kitti/000042 --group nms\n"
+          "  fusedet detect -m models/car.json --stack data/kitti_set --item kitti/000042\n"
           "  fusedet detect -m eye.xml -i face.png --min-neighbors 0 --min-size 30x30   # raw hits\n"
           "  fusedet detect -m models/car.json --stack data/kitti_set --no-class-detection   # car as person/bike\n"
           "Prints a summary line, the grouping used, then one line per detection (class, score, box in pixels).\n\n"

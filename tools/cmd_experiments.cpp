@@ -80,8 +80,6 @@ struct ExperimentOptions {
   double scaleFactor = 0;
   double step = 0;
   int minNeighbors = 3;
-  std::string grouping = "opencv";  // opencv | nms (boosting::GroupParams)
-  double nmsIou = 0.5;
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
   bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
   double boxFitLambda = boosting::BoxFitParams{}.lambda;
@@ -344,9 +342,7 @@ boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
 // Grouping of the raw hits, as the options give it (fusedetd's detection.* keys mean the same).
 boosting::GroupParams groupParams(const ExperimentOptions& o) {
   boosting::GroupParams g;
-  g.method = o.grouping == "nms" ? boosting::GroupParams::Method::kNms : boosting::GroupParams::Method::kOpenCv;
   g.minNeighbors = o.minNeighbors;
-  g.iouThreshold = o.nmsIou;
   return g;
 }
 
@@ -363,7 +359,6 @@ std::string trainingPositivesText(const ExperimentOptions& o) {
 }
 
 std::string groupingText(const ExperimentOptions& o) {
-  if (o.grouping == "nms") return "non-maximum suppression by last stage sum, IoU > " + shortNum(o.nmsIou);
   std::string t = "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors);
   return t;
 }
@@ -1255,14 +1250,6 @@ const bool registered = registerCommand(
       app.add_option("--min-neighbors", o->minNeighbors,
                      "grouping: hits a detection needs (car: its own where the preset uses per-class detection; "
                      "given, for every class)")
-          ->capture_default_str();
-      app.add_option("--grouping", o->grouping,
-                     "grouping of raw hits: opencv (cv::groupRectangles' rule, score = group size) or nms "
-                     "(score-based non-maximum suppression, score = last stage sum), as fusedetd's detection.grouping")
-          ->check(CLI::IsMember({"opencv", "nms"}))
-          ->capture_default_str();
-      app.add_option("--nms-iou", o->nmsIou, "--grouping nms: a hit overlapping a kept one with IoU above this is dropped")
-          ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       app.add_flag("--laser-extent", o->laserExtent,
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "

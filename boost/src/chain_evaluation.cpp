@@ -20,7 +20,6 @@ void refineBoxes(std::vector<Detection>& detections, const std::vector<std::vect
   for (std::size_t k = 0; k < hits.size() && k < fates.size(); ++k)
     for (std::size_t i = 0; i < hits[k].size() && i < fates[k].size(); ++i) {
       const HitFate& f = fates[k][i];
-      // Members only: a hit suppressed by NMS is not.
       if (f.outcome == HitFate::Outcome::kKept && f.detection >= 0 && static_cast<std::size_t>(f.detection) < g.size())
       {
         g[static_cast<std::size_t>(f.detection)].members.push_back(hits[k][i].box);

@@ -52,8 +52,7 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     d << "validation part " << v.part << " min_hit " << v.minHit << " min_positives " << v.minPositives << " max_cascade_fa "
       << v.maxCascadeFalseAlarm << " scan " << v.detection.scan.scaleFactor << " " << v.detection.scan.step << " "
       << v.detection.scan.minWidth << " " << v.detection.scan.minHeight << " group "
-      << static_cast<int>(v.detection.group.method) << " " << v.detection.group.minNeighbors << " "
-      << v.detection.group.eps << " " << v.detection.group.iouThreshold;
+      << v.detection.group.minNeighbors << " " << v.detection.group.eps;
     d << " match " << v.match.className << " "
       << v.match.minIou << " " << v.match.minHeight << " " << v.match.maxOcclusion << " " << v.match.maxTruncation
       << " " << v.match.minDetectionHeight << " aliases " << joined(v.match.aliasClasses) << " neighbours "

@@ -128,38 +128,13 @@ std::vector<Detection> groupOpenCv(std::span<const RawHit> hits, const GroupPara
   return out;
 }
 
-std::vector<Detection> groupNms(std::span<const RawHit> hits, const GroupParams& p, const std::string& cls,
-                                const LayerStack& stack, std::vector<HitFate>& fates) {
-  fates.assign(hits.size(), HitFate{});
-  std::vector<std::size_t> order(hits.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return hits[a].score > hits[b].score; });
-  std::vector<Detection> out;
-  std::vector<Box> kept;
-  for (std::size_t i : order) {
-    bool suppressed = false;
-    for (std::size_t k = 0; k < kept.size(); ++k)
-      if (iou(hits[i].box, kept[k]) > p.iouThreshold) {
-        suppressed = true;
-        fates[i] = {HitFate::Outcome::kSuppressed, static_cast<int>(k), 1};
-        break;
-      }
-    if (suppressed) continue;
-    fates[i].detection = static_cast<int>(out.size());
-    kept.push_back(hits[i].box);
-    out.push_back(makeDetection(hits[i].box, hits[i].score, cls, stack));
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<Detection> groupHits(std::span<const RawHit> hits, const GroupParams& params, const std::string& className,
                                  const LayerStack& stack, std::vector<HitFate>* fates) {
   std::vector<HitFate> local;
   std::vector<HitFate>& f = fates ? *fates : local;
-  return params.method == GroupParams::Method::kNms ? groupNms(hits, params, className, stack, f)
-                                                    : groupOpenCv(hits, params, className, stack, f);
+  return groupOpenCv(hits, params, className, stack, f);
 }
 
 std::vector<Detection> detect(const Detector& detector, const LayerStack& stack, const ScanParams& scan,

@@ -206,8 +206,6 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     s.read("min_size", c.detection.minSize);
     s.read("max_size", c.detection.maxSize);
     s.readRange("step", c.detection.step, 0.1, 64.0);
-    s.readOneOf<std::string>("grouping", c.detection.grouping, {"nms", "opencv"});
-    s.readRange("nms_iou", c.detection.nmsIou, 0.0, 1.0);
     s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
     s.read("laser_extent", c.detection.laserExtent);
     s.readRange("threads", c.detection.threads, 0, 256);
@@ -324,8 +322,6 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "max_size" << YAML::Value;
   seq(c.detection.maxSize);
   out << YAML::Key << "step" << YAML::Value << c.detection.step;
-  out << YAML::Key << "grouping" << YAML::Value << c.detection.grouping;
-  out << YAML::Key << "nms_iou" << YAML::Value << c.detection.nmsIou;
   out << YAML::Key << "min_neighbors" << YAML::Value << c.detection.minNeighbors;
   out << YAML::Key << "laser_extent" << YAML::Value << c.detection.laserExtent;
   out << YAML::Key << "threads" << YAML::Value << c.detection.threads;

@@ -24,9 +24,7 @@ boosting::ScanParams scanParamsFrom(const Config::Detection& d) {
 
 boosting::GroupParams groupParamsFrom(const Config::Detection& d) {
   boosting::GroupParams g;
-  g.method = d.grouping == "nms" ? boosting::GroupParams::Method::kNms : boosting::GroupParams::Method::kOpenCv;
   g.minNeighbors = d.minNeighbors;
-  g.iouThreshold = d.nmsIou;
   return g;
 }
 

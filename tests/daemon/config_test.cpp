@@ -23,7 +23,6 @@ TEST(Config, ShippedFileParsesAndEqualsTheDefaults) {
   // The documented file and the built-in defaults must not drift apart.
   EXPECT_EQ(dumpConfig(shipped), dumpConfig(Config{}));
   EXPECT_EQ(shipped.laser.baud, 38400);
-  EXPECT_EQ(shipped.detection.grouping, "opencv");
 }
 
 TEST(Config, EmptyFileGivesDefaultsAndDumpRoundTrips) {

@@ -1,4 +1,4 @@
-// Grouping against its peer (cv::groupRectangles on the same rectangles) and NMS by hand; and the
+// Grouping against its peer (cv::groupRectangles on the same rectangles); and the
 // integral images of the OpenCV path against cv::integral.
 
 #include "fusedet/boost/grouping.h"
@@ -63,28 +63,6 @@ TEST(Grouping, OpenCvRuleEqualsCvGroupRectangles) {
     }
   }
   EXPECT_GT(compared, 200);
-}
-
-TEST(Grouping, NmsKeepsTheBestOfOverlappingHits) {
-  LayerStack stack(200, 100);
-  stack.id = 7;
-  const std::vector<RawHit> hits = {
-      {Box{10, 10, 40, 40}, 1.0, 0}, {Box{12, 10, 40, 40}, 3.0, 0},  // overlap: keep the 3.0
-      {Box{100, 50, 20, 20}, 0.5, 0},                                 // alone
-      {Box{14, 12, 40, 40}, 2.0, 0},                                  // overlaps the 3.0 one too
-      {Box{40, 10, 40, 40}, 2.5, 0}};                                 // IoU with 3.0 box below 0.5
-  GroupParams p;
-  p.method = GroupParams::Method::kNms;
-  p.iouThreshold = 0.5;
-  const auto d = groupHits(hits, p, "car", stack);
-  ASSERT_EQ(d.size(), 3u);
-  EXPECT_EQ(d[0].score, 3.0);
-  EXPECT_EQ(d[1].score, 2.5);
-  EXPECT_EQ(d[2].score, 0.5);
-  EXPECT_EQ(d[0].box, (Box{12, 10, 40, 40}));
-  EXPECT_EQ(d[0].stackId, 7u);
-  EXPECT_DOUBLE_EQ(d[2].unitBox.x, 0.5);
-  EXPECT_DOUBLE_EQ(d[2].unitBox.h, 0.2);
 }
 
 TEST(CvIntegrals, SumSquaredAndTiltedEqualCvIntegral) {

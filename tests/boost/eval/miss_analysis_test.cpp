@@ -296,19 +296,5 @@ TEST(GroupingFates, EveryHitKnowsItsDetectionOrWhyItHasNone) {
       // A detection's score is the size of its group (nb > 0): exactly the hits that name it.
       for (std::size_t d = 0; d < with.size(); ++d) EXPECT_EQ(members[d], nb > 0 ? int(with[d].score) : 1);
     }
-    GroupParams nms;
-    nms.method = GroupParams::Method::kNms;
-    std::vector<HitFate> fates;
-    const std::vector<Detection> kept = groupHits(hits, nms, "car", stack, &fates);
-    for (std::size_t i = 0; i < hits.size(); ++i) {
-      ASSERT_GE(fates[i].detection, 0);
-      const Detection& d = kept[static_cast<std::size_t>(fates[i].detection)];
-      if (fates[i].outcome == HitFate::Outcome::kSuppressed) {
-        EXPECT_GT(iou(d.box, hits[i].box), nms.iouThreshold);
-        EXPECT_GE(d.score, hits[i].score);
-      } else {
-        EXPECT_EQ(d.box, hits[i].box);
-      }
-    }
   }
 }

@@ -46,7 +46,7 @@ Box applyTargets(const Box& box, const BoxTargets& t);
 struct GroupedBox {
   Box box;
   Box groupBox;
-  std::vector<Box> members;  // empty: NMS's single hit, or no member information (the box itself)
+  std::vector<Box> members;  // empty: no member information (the box itself)
   std::vector<double> memberScores;  // per member: its last-stage sum (group_verifier.h reads them)
 };
 

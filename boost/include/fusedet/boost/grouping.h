@@ -1,13 +1,10 @@
 #pragma once
-// From raw window hits to detections, two ways:
-//  - kOpenCv: cv::groupRectangles' rule - hits whose four edges lie within eps * mean(min width,
-//    min height) / 2 of each other are linked, linked sets form groups (transitively), a group
-//    becomes its average rectangle if it has more than minNeighbors members, and groups that sit
-//    inside a bigger, better supported group are dropped. Score = members in the group.
-//    minNeighbors <= 0 returns every hit unchanged (OpenCV's behaviour).
-//  - kNms: greedy non-maximum suppression by score (the last stage's sum): a hit is dropped when it
-//    overlaps an already kept one with IoU > iouThreshold. Score = the hit's score.
-// Output order is deterministic: groups by their first hit, NMS by descending score then index.
+// From raw window hits to detections by cv::groupRectangles' rule: hits whose four edges lie within
+// eps * mean(min width, min height) / 2 of each other are linked, linked sets form groups
+// (transitively), a group becomes its average rectangle if it has more than minNeighbors members,
+// and groups that sit inside a bigger, better supported group are dropped. Score = members in the
+// group. minNeighbors <= 0 returns every hit unchanged (OpenCV's behaviour). Output order is
+// deterministic: groups by their first hit.
 
 #include <span>
 #include <string>
@@ -20,24 +17,20 @@
 namespace fusedet::boosting {
 
 struct GroupParams {
-  enum class Method { kOpenCv, kNms };
-  Method method = Method::kOpenCv;
-  int minNeighbors = 3;        // kOpenCv
-  double eps = 0.2;            // kOpenCv (OpenCV's GROUP_EPS)
-  double iouThreshold = 0.5;   // kNms
+  int minNeighbors = 3;
+  double eps = 0.2;  // OpenCV's GROUP_EPS
 };
 
 // What became of one raw hit (miss_analysis.h asks): the detection it went into, or why none.
 struct HitFate {
   enum class Outcome {
-    kKept,               // part of a group (or NMS's kept hit) that became output detection `detection`
-    kTooFewNeighbours,   // kOpenCv: its group had <= minNeighbors members
-    kInsideBiggerGroup,  // kOpenCv: its group lay inside a bigger, better supported one
-    kSuppressed,         // kNms: a higher-scored hit with IoU > iouThreshold was kept (`detection`)
+    kKept,               // part of a group that became output detection `detection`
+    kTooFewNeighbours,   // its group had <= minNeighbors members
+    kInsideBiggerGroup,  // its group lay inside a bigger, better supported one
   };
   Outcome outcome = Outcome::kKept;
   int detection = -1;  // index into groupHits()' output, -1 when the hit went into none
-  int groupSize = 1;   // members of its group (kOpenCv), else 1
+  int groupSize = 1;   // members of its group
 };
 
 // Detections for `className` in `stack` (boxes in its reference pixels, unitBox, stamp, stackId).

@@ -81,8 +81,6 @@ struct Config {
     std::array<int, 2> minSize{0, 0};
     std::array<int, 2> maxSize{0, 0};
     double step = 2;  // base-window pixels, scaled with the window (ScanParams::step)
-    std::string grouping = "opencv";
-    double nmsIou = 0.5;
     int minNeighbors = 3;
     bool laserExtent = false;  // boosting::LaserExtentParams::enabled
     int threads = 0;
