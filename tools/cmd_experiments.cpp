@@ -94,7 +94,6 @@ struct ExperimentOptions {
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
   std::size_t minPositives = 4;
-  std::string contrastNormalise = "none";  // boosting::parseContrastNormalised, per configuration
   int validationPart = -1;  // -1 = the preset's
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
@@ -370,7 +369,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.pool.grid = p.grid;
   c.pool.layers = tc.layers;
   c.pool.types = boosting::parseFeatureTypes(tc.types);
-  c.pool.contrastNormalised = boosting::parseContrastNormalised(o.contrastNormalise, tc.layers, true);
   c.samples.className = cls;
   // Training positives (--training-positives): the evaluation's match widened for training only;
   // the validation part below is scored with the evaluation's own.
@@ -546,11 +544,6 @@ int runExperiments(ExperimentOptions o) {
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
-  {  // a layer no configuration has is a typo
-    std::vector<std::string> known;
-    for (const TrainedConfig& t : trainedConfigs()) known.insert(known.end(), t.layers.begin(), t.layers.end());
-    boosting::parseContrastNormalised(o.contrastNormalise, known);
-  }
   {
     boosting::TrainingConfig probe;
     try {
@@ -702,7 +695,6 @@ int runExperiments(ExperimentOptions o) {
                                       ", threshold at the highest training F (boost/group_verifier.h)"
        : o.verifier == "gate"   ? "gate: per fold, pixel height x distance within the 2nd-98th percentiles of its training hits'"
                                 : "off"},
-      {"contrast-normalised layers", o.contrastNormalise},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
                                          : "the devkit's: car " + shortNum(boosting::kittiMinOverlap("car")) +
@@ -1299,11 +1291,6 @@ const bool registered = registerCommand(
                    "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
                    "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
                    "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
-      app.add_option("--contrast-normalise", o->contrastNormalise,
-                     "contrast normalisation of the trained cascades (Viola-Jones: features divided by the "
-                     "window's standard deviation of their layer): none, camera (red, green, blue, intensity "
-                     "where a configuration has them) or layer names (each configuration normalises those it has)")
-          ->capture_default_str();
       app.add_option("--validation", o->validationPart,
                      "N >= 2: each fold's trainer holds back about 1/N of its training frames (whole drives, "
                      "smallest first; never trained on): stage thresholds keep the min hit rate on their "

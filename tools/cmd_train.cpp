@@ -37,7 +37,6 @@ struct TrainOptions {
   std::string className = "car";
   std::string layers = "red,green,blue,intensity,hue_distance,distance,remission";
   std::string types = "all";
-  std::string contrastNormalise = "none";
   int grid = 16, positionStep = 1, sizeStep = 1, minCell = 1;
   int windowHeight = 24;
   double minHit = 0.995, maxFa = 0.5, targetFa = 1e-5;
@@ -204,7 +203,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.className = o.className;
   c.pool.layers = splitList(o.layers);
   c.pool.types = boosting::parseFeatureTypes(o.types);
-  c.pool.contrastNormalised = boosting::parseContrastNormalised(o.contrastNormalise, c.pool.layers);
   c.pool.grid = o.grid;
   c.pool.positionStep = o.positionStep;
   c.pool.sizeStep = o.sizeStep;
@@ -336,7 +334,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"max_fa", std::to_string(o.maxFa)},
       {"stop_reason", report.stopReason},
   };
-  if (!c.pool.contrastNormalised.empty()) info.emplace_back("contrast_normalise", o.contrastNormalise);
   if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
@@ -373,11 +370,6 @@ const bool registered = registerCommand(
       app.add_option("--types", o->types,
                      "feature types of the pool: letters a-j (paper Fig. 1) and ranges, e.g. a-f (no corner "
                      "features), g-j, or all")
-          ->capture_default_str();
-      app.add_option("--contrast-normalise", o->contrastNormalise,
-                     "layers whose features are divided by the window's standard deviation of the layer "
-                     "(Viola-Jones contrast normalisation, floor 1 layer unit; recorded in the model): none, "
-                     "camera (red, green, blue, intensity of the pool) or comma-separated layer names")
           ->capture_default_str();
       app.add_option("--grid", o->grid, "grid units per side of the unit square the pool is laid on")
           ->capture_default_str();
@@ -494,7 +486,6 @@ const bool registered = registerCommand(
           "  fusedet import-kitti --out ds\n"
           "  fusedet train --data ds --class car --out car.json\n"
           "  fusedet train --data ds --class car --layers intensity,hue_distance --types a-f --grid 12\n"
-          "  fusedet train --data ds --class car --contrast-normalise camera\n"
           "  fusedet train --data ds --groups kitti --train-only kitti_0009 --test-list test.txt --eval\n"
           "  mpirun -np 4 --hostfile hosts fusedet train --data ds --class car --out car.json\n\n"
           "Distributed (docs/distributed.md): started by mpirun or srun, the ranks split the training\n"

@@ -39,11 +39,6 @@ void Cascade::validate() const {
   } else if (!haarFeatures.empty()) {
     fail("pixel (OpenCV) features need OpenCV variance normalisation");
   }
-  if (!contrastNormalised.empty() && contrastNormalised.size() != layers.size())
-    fail("contrast normalisation flags for " + std::to_string(contrastNormalised.size()) + " layers, the model has " +
-         std::to_string(layers.size()));
-  if (isOpenCv() && !contrastNormalised.empty())
-    fail("an OpenCV cascade has its own variance normalisation, not per-layer contrast normalisation");
   for (const std::string& l : layers)
     if (l == "hue_distance" && !referenceHue) fail("layer hue_distance needs a reference hue");
   if (referenceHue && !std::isfinite(*referenceHue)) fail("reference hue is not finite");

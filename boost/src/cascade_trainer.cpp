@@ -171,12 +171,11 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   }
   report.referenceHue = refHue;
 
-  const std::vector<bool> normalised = config.pool.contrastFlags();
-  const TrainingStacks stacks(train, layers, refHue, config.samples, shard, normalised, config.threads);
+  const TrainingStacks stacks(train, layers, refHue, config.samples, shard, config.threads);
   report.positives = stacks.positives().size();
   SampleConfig heldSamples = config.samples;
   heldSamples.jitterCopies = 0;  // the held-back positives as labelled (and mirrored)
-  const TrainingStacks held(heldItems, layers, refHue, heldSamples, Shard{}, normalised);
+  const TrainingStacks held(heldItems, layers, refHue, heldSamples);
   report.validationItems = heldItems.size();
   report.validationPositives = held.positives().size();
   if (stacks.positives().empty())
@@ -188,7 +187,6 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   Cascade cascade;
   cascade.className = config.className;
   cascade.layers = layers;
-  cascade.contrastNormalised = normalised;
   cascade.referenceHue = refHue;
   cascade.windowHeight = config.samples.baseWindowHeight;
   cascade.windowWidth = std::max(
@@ -216,9 +214,6 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                 std::to_string(stacks.originalStacks()) + " stacks" +
                 (config.samples.flipPositives ? ", mirrored copies included" : "") + "), window " +
                 std::to_string(cascade.windowWidth) + "x" + std::to_string(cascade.windowHeight) +
-                (config.pool.contrastNormalised.empty()
-                     ? std::string()
-                     : ", contrast-normalised " + std::to_string(config.pool.contrastNormalised.size()) + " layers") +
                 ", smallest positive " + std::to_string(report.minHeight) + " px high" +
                 (refHue ? ", reference hue " + fixed(*refHue, 0) + " deg" : std::string()) + ", " +
                 std::to_string(wanted) + " negatives per stage" +

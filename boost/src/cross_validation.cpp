@@ -22,10 +22,8 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
   std::ostringstream d;
   d.precision(17);
   d << "class " << c.className << "\npool grid " << c.pool.grid << " position_step " << c.pool.positionStep
-    << " min_cell " << c.pool.minCellSize << " size_step " << c.pool.sizeStep << " layers " << joined(c.pool.layers);
-  // Only when set: the keys of unnormalised configurations stay those of earlier caches.
-  if (!c.pool.contrastNormalised.empty()) d << " contrast_normalised " << joined(c.pool.contrastNormalised);
-  d << " types";
+    << " min_cell " << c.pool.minCellSize << " size_step " << c.pool.sizeStep << " layers " << joined(c.pool.layers)
+    << " types";
   for (FeatureType t : c.pool.types) d << " " << static_cast<int>(t);
   d << "\nsamples min_height " << c.samples.minPositiveHeight << " max_occlusion " << c.samples.maxOcclusion
     << " flip " << c.samples.flipPositives << " max_negative_iou " << c.samples.maxNegativeIou

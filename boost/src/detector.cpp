@@ -21,16 +21,6 @@ namespace fusedet::boosting {
 
 namespace {
 
-// Integrals built for another normalisation than the model's would give other feature values.
-void checkContrastNormalisation(const Cascade& c, const IntegralStack& in, const char* who) {
-  for (std::size_t l = 0; l < in.size(); ++l)
-    if (c.isContrastNormalised(l) != in.layer(l).contrastNormalised)
-      throw std::invalid_argument(std::string(who) + ": layer '" + in.layer(l).name + "' is " +
-                                  (c.isContrastNormalised(l) ? "" : "not ") +
-                                  "contrast-normalised in the model, but its integrals are " +
-                                  (in.layer(l).contrastNormalised ? "" : "not ") + "(use integrateFor())");
-}
-
 template <class Body>
 void forEachRow(std::size_t rows, int threads, const Body& body) {
   if (threads == 1) {
@@ -55,10 +45,6 @@ void forEachRow(std::size_t rows, int threads, const Body& body) {
 WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box& window) {
   if (c.isOpenCv())
     throw std::invalid_argument("evaluateWindow: OpenCV models run on their image pyramid (Detector::scan)");
-  if (in.size() != c.layers.size())
-    throw std::invalid_argument("evaluateWindow: integrals hold " + std::to_string(in.size()) + " layers, the model reads " +
-                                std::to_string(c.layers.size()));
-  if (!c.contrastNormalised.empty()) checkContrastNormalisation(c, in, "evaluateWindow");
   WindowResult r;
   for (const Stage& st : c.stages) {
     double sum = 0;
@@ -75,7 +61,7 @@ WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box
 }
 
 IntegralStack integrateFor(const Cascade& c, const LayerStack& stack) {
-  return IntegralStack(stack, c.layers, c.referenceHue, false, c.contrastNormalised);
+  return IntegralStack(stack, c.layers, c.referenceHue);
 }
 
 Detector::Detector(Cascade cascade) : cascade_(std::move(cascade)) { cascade_.validate(); }
@@ -102,7 +88,6 @@ std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& pa
   if (in.size() != cascade_.layers.size())
     throw std::invalid_argument("Detector::scan: integrals hold " + std::to_string(in.size()) +
                                 " layers, the model reads " + std::to_string(cascade_.layers.size()));
-  checkContrastNormalisation(cascade_, in, "Detector::scan");
   const std::vector<ScalePlan> plans = planScales(cascade_, in, params);
   // Work items: a band of columns of one scale, all its rows. Bands keep the integral rows a
   // window touches in cache while y advances (a whole image row of 7 double layers does not fit);
@@ -118,25 +103,18 @@ std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& pa
   std::vector<std::vector<RawHit>> hits(items.size());
   std::vector<std::size_t> stumpCount(items.size(), 0);
   const std::size_t nl = in.size();
-  std::vector<const double*> layerData(nl), sqData(nl);
-  for (std::size_t l = 0; l < nl; ++l) {
-    layerData[l] = in.layer(l).sum.data();
-    sqData[l] = in.layer(l).sqsum.data();  // the same layout; only read for normalised layers
-  }
+  std::vector<const double*> layerData(nl);
+  for (std::size_t l = 0; l < nl; ++l) layerData[l] = in.layer(l).sum.data();
   forEachRow(items.size(), params.threads, [&](std::size_t i) {
     const Item& it = items[i];
     const ScalePlan& sp = plans[it.scale];
-    std::vector<const double*> base(nl), rowBase(nl), sqBase(nl);
-    std::vector<double> contrast(nl, 1.0);
+    std::vector<const double*> base(nl), rowBase(nl);
     std::size_t stumps = 0;
     for (std::size_t yi = 0; yi < sp.ys.size(); ++yi) {
       for (std::size_t l = 0; l < nl; ++l) rowBase[l] = layerData[l] + sp.rowOfs[l][yi];
       for (std::size_t xi = it.x0; xi < it.x1; ++xi) {
         for (std::size_t l = 0; l < nl; ++l) base[l] = rowBase[l] + sp.colOfs[l][xi];
-        for (const ScalePlan::Contrast& k : sp.contrasts)
-          sqBase[k.layer] = sqData[k.layer] + sp.rowOfs[k.layer][yi] + sp.colOfs[k.layer][xi];
-        windowContrasts(sp, base.data(), sqBase.data(), contrast.data());
-        const WindowResult r = runWindow(sp, base.data(), contrast.data(), stumps);
+        const WindowResult r = runWindow(sp, base.data(), stumps);
         if (r.accepted)
           hits[i].push_back(RawHit{Box{double(sp.xs[xi]), double(sp.ys[yi]), double(sp.winW), double(sp.winH)},
                                    r.score, static_cast<int>(it.scale)});

@@ -151,18 +151,6 @@ PixelRect featureRectInWindow(const Feature& f, int w, int h) {
   return r;
 }
 
-double contrastStdDev(double sum, double sqSum, double area) {
-  const double mean = sum / area;
-  const double variance = sqSum / area - mean * mean;
-  return std::sqrt(std::max(variance, kContrastFloor * kContrastFloor));
-}
-
-double windowContrast(const LayerIntegral& li, const LayerWindow& lw) {
-  if (li.sqsum.empty()) throw std::logic_error("windowContrast: layer '" + li.name + "' has no squared sums");
-  const int x1 = lw.x + lw.w, y1 = lw.y + lw.h;
-  return contrastStdDev(li.rectSum(lw.x, lw.y, x1, y1), li.rectSqSum(lw.x, lw.y, x1, y1), double(lw.w) * double(lw.h));
-}
-
 float featureValue(const IntegralStack& integrals, const Feature& f, const Box& window) {
   const LayerIntegral& li = integrals.layer(static_cast<std::size_t>(f.layer));
   const LayerWindow lw = layerWindow(li, integrals.width(), integrals.height(), window);
@@ -179,9 +167,7 @@ float featureValue(const IntegralStack& integrals, const Feature& f, const Box& 
   const double black = l.blackCount == 2 ? rs(0) + rs(1) : rs(0);
   const double last = rs(l.blackCount);
   const double white = l.whiteIsRest ? last - black : last;
-  const double value = black / l.blackArea - white / l.whiteArea;
-  if (li.contrastNormalised) return static_cast<float>(value / windowContrast(li, lw));
-  return static_cast<float>(value);
+  return static_cast<float>(black / l.blackArea - white / l.whiteArea);
 }
 
 void featureValues(const IntegralStack& integrals, std::span<const Feature> features,

@@ -4,8 +4,6 @@
 #include <set>
 #include <stdexcept>
 
-#include "fusedet/core/layer_stack.h"
-
 namespace fusedet::boosting {
 
 namespace {
@@ -53,51 +51,6 @@ void PoolConfig::validate() const {
   for (FeatureType t : types)
     if (!seenTypes.insert(t).second)
       throw std::invalid_argument(std::string("feature pool: type '") + toLetter(t) + "' selected twice");
-  std::set<std::string> normalised;
-  for (const auto& l : contrastNormalised) {
-    if (!seen.count(l))
-      throw std::invalid_argument("feature pool: contrast-normalised layer '" + l + "' is not one of the pool's layers");
-    if (!normalised.insert(l).second)
-      throw std::invalid_argument("feature pool: contrast-normalised layer '" + l + "' named twice");
-  }
-}
-
-std::vector<std::string> parseContrastNormalised(const std::string& spec, const std::vector<std::string>& layers,
-                                                 bool skipAbsent) {
-  if (spec.empty() || spec == "none") return {};
-  std::vector<std::string> out;
-  if (spec == "camera") {
-    for (const auto& l : layers)
-      if (l == layer::kRed || l == layer::kGreen || l == layer::kBlue || l == layer::kIntensity) out.push_back(l);
-    return out;
-  }
-  std::size_t start = 0;
-  while (start <= spec.size()) {
-    const std::size_t end = std::min(spec.find(',', start), spec.size());
-    const std::string name = spec.substr(start, end - start);
-    const bool present = std::find(layers.begin(), layers.end(), name) != layers.end();
-    if (!present && skipAbsent) {
-      start = end + 1;
-      continue;
-    }
-    if (!present) {
-      std::string have;
-      for (const auto& l : layers) have += (have.empty() ? "" : ",") + l;
-      throw std::invalid_argument("contrast normalisation: '" + name + "' is not a layer of the pool (" + have +
-                                  "; or use camera / none)");
-    }
-    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
-    start = end + 1;
-  }
-  return out;
-}
-
-std::vector<bool> PoolConfig::contrastFlags() const {
-  if (contrastNormalised.empty()) return {};
-  std::vector<bool> flags;
-  for (const auto& l : layers)
-    flags.push_back(std::find(contrastNormalised.begin(), contrastNormalised.end(), l) != contrastNormalised.end());
-  return flags;
 }
 
 std::size_t poolSize(const PoolConfig& c, FeatureType type) {

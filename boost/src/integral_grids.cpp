@@ -18,12 +18,10 @@ struct Source {
   cv::Mat data;
   std::optional<double> hueReference;  // set: data is hue (CV_32F), the slot is hue_distance
   cv::Mat hueValid;                     // the hue layer's mask (empty = every pixel has a hue)
-  bool squared = false;                 // the slot sums squared values
 };
 
-// Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum
-// (kSquared: rowSum += v * v in double, as its squared sums).
-template <class T, class Acc, bool kSquared = false>
+// Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum.
+template <class T, class Acc>
 void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
   const int w = data.cols, h = data.rows;
   for (int y = 0; y < h; ++y) {
@@ -32,14 +30,12 @@ void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
     Acc* cur = slot0 + (y + 1) * pitch;
     Acc rowSum = 0;
     for (int x = 0; x < w; ++x) {
-      const Acc v = static_cast<Acc>(row[x]);
-      rowSum += kSquared ? v * v : v;
+      rowSum += static_cast<Acc>(row[x]);
       cur[x + 1] = prev[x + 1] + rowSum;
     }
   }
 }
 
-template <bool kSquared>
 void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, double* slot0,
                           std::ptrdiff_t pitch) {
   const int w = hue.cols, h = hue.rows;
@@ -51,8 +47,7 @@ void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double refer
     double* cur = slot0 + (y + 1) * pitch;
     double rowSum = 0;
     for (int x = 0; x < w; ++x) {
-      const double v = static_cast<double>(dist[static_cast<std::size_t>(x)]);
-      rowSum += kSquared ? v * v : v;
+      rowSum += static_cast<double>(dist[static_cast<std::size_t>(x)]);
       cur[x + 1] = prev[x + 1] + rowSum;
     }
   }
@@ -64,16 +59,7 @@ bool fitsInt32(const cv::Mat& data) {
 }
 
 void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
-  if (s.hueReference)
-    return s.squared ? integrateHueDistance<true>(s.data, s.hueValid, *s.hueReference, slot0, pitch)
-                     : integrateHueDistance<false>(s.data, s.hueValid, *s.hueReference, slot0, pitch);
-  if (s.squared) switch (s.data.depth()) {
-      case CV_8U: return integrateSlot<std::uint8_t, double, true>(s.data, slot0, pitch);
-      case CV_16U: return integrateSlot<std::uint16_t, double, true>(s.data, slot0, pitch);
-      case CV_32F: return integrateSlot<float, double, true>(s.data, slot0, pitch);
-      case CV_64F: return integrateSlot<double, double, true>(s.data, slot0, pitch);
-      default: throw std::invalid_argument("IntegralGrids: layer depth must be 8U, 16U, 32F or 64F");
-    }
+  if (s.hueReference) return integrateHueDistance(s.data, s.hueValid, *s.hueReference, slot0, pitch);
   switch (s.data.depth()) {
     case CV_8U: return integrateSlot<std::uint8_t>(s.data, slot0, pitch);
     case CV_16U: return integrateSlot<std::uint16_t>(s.data, slot0, pitch);
@@ -144,9 +130,8 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
         throw std::invalid_argument("IntegralGrids: layer '" + r.name + "' must be a non-empty single-channel image");
       src.data = l->data;
     }
-    src.squared = r.squared;
     const int w = src.data.cols, h = src.data.rows;
-    const bool exactInt = !src.hueReference && !r.squared && fitsInt32(src.data);
+    const bool exactInt = !src.hueReference && fitsInt32(src.data);
     auto g = std::find_if(grids_.begin(), grids_.end(),
                           [&](const IntegralGrid& x) { return x.width == w && x.height == h && x.exactInt == exactInt; });
     if (g == grids_.end()) {
@@ -211,7 +196,7 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
 
 LayerRequest IntegralGrids::normalized(const LayerRequest& r) const {
   if (r.name == layer::kHueDistance && !stackHasHueDistance_) return r;
-  return LayerRequest{r.name, std::nullopt, r.squared};
+  return LayerRequest{r.name, std::nullopt};
 }
 
 SlotRef IntegralGrids::find(const LayerRequest& request) const {

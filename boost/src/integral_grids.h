@@ -12,8 +12,7 @@
 // order. 8-bit layers whose whole sum stays below 2^31 get int32 tables instead (exact integers
 // either way, so every rectangle sum converts to the same double), half the memory to stream.
 // `hue_distance` is derived per reference hue (each class may have its own); a stack that carries
-// its own hue_distance layer is used as is, as IntegralStack does. Tables of squared values (for
-// contrast-normalised layers) are those of integrateLayer(..., squared = true), in double grids.
+// its own hue_distance layer is used as is, as IntegralStack does.
 
 #include <cstddef>
 #include <cstdint>
@@ -25,12 +24,10 @@
 
 namespace fusedet::boosting {
 
-// A layer a model reads: its name and, for hue_distance, the model's reference hue; squared: the
-// table of its squared values (contrast normalisation, feature.h), always double.
+// A layer a model reads: its name and, for hue_distance, the model's reference hue.
 struct LayerRequest {
   std::string name;
   std::optional<double> referenceHue;
-  bool squared = false;
   bool operator==(const LayerRequest&) const = default;
 };
 

@@ -9,11 +9,10 @@ namespace fusedet::boosting {
 namespace {
 
 template <class T>
-void integrate(const cv::Mat& data, LayerIntegral& out, bool squared) {
+void integrate(const cv::Mat& data, LayerIntegral& out) {
   const int w = data.cols, h = data.rows;
   const std::ptrdiff_t s = out.stride();
   double* sum = out.sum.data();
-  double* sq = squared ? out.sqsum.data() : nullptr;
   for (int y = 0; y < h; ++y) {
     const T* row = data.ptr<T>(y);
     double* prev = sum + y * s;
@@ -23,22 +22,12 @@ void integrate(const cv::Mat& data, LayerIntegral& out, bool squared) {
       rowSum += static_cast<double>(row[x]);
       cur[x + 1] = prev[x + 1] + rowSum;
     }
-    if (sq) {
-      double* sprev = sq + y * s;
-      double* scur = sprev + s;
-      double rowSq = 0;
-      for (int x = 0; x < w; ++x) {
-        const double v = static_cast<double>(row[x]);
-        rowSq += v * v;
-        scur[x + 1] = sprev[x + 1] + rowSq;
-      }
-    }
   }
 }
 
 }  // namespace
 
-LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data, bool squared) {
+LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data) {
   if (data.channels() != 1 || data.empty())
     throw std::invalid_argument("integrateLayer: layer '" + name + "' must be a non-empty single-channel image");
   LayerIntegral out;
@@ -47,12 +36,11 @@ LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data, bool 
   out.height = data.rows;
   const std::size_t n = static_cast<std::size_t>(data.cols + 1) * static_cast<std::size_t>(data.rows + 1);
   out.sum.assign(n, 0.0);
-  if (squared) out.sqsum.assign(n, 0.0);
   switch (data.depth()) {
-    case CV_8U: integrate<std::uint8_t>(data, out, squared); break;
-    case CV_16U: integrate<std::uint16_t>(data, out, squared); break;
-    case CV_32F: integrate<float>(data, out, squared); break;
-    case CV_64F: integrate<double>(data, out, squared); break;
+    case CV_8U: integrate<std::uint8_t>(data, out); break;
+    case CV_16U: integrate<std::uint16_t>(data, out); break;
+    case CV_32F: integrate<float>(data, out); break;
+    case CV_64F: integrate<double>(data, out); break;
     default:
       throw std::invalid_argument("integrateLayer: layer '" + name + "' must be 8U, 16U, 32F or 64F");
   }
@@ -60,19 +48,12 @@ LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data, bool 
 }
 
 IntegralStack::IntegralStack(const LayerStack& stack, std::span<const std::string> layers,
-                             std::optional<double> referenceHue, bool squaredAll,
-                             const std::vector<bool>& contrastNormalised)
+                             std::optional<double> referenceHue)
     : width_(stack.width()), height_(stack.height()) {
   if (width_ <= 0 || height_ <= 0)
     throw std::invalid_argument("IntegralStack: stack has no reference size");
-  if (!contrastNormalised.empty() && contrastNormalised.size() != layers.size())
-    throw std::invalid_argument("IntegralStack: " + std::to_string(contrastNormalised.size()) +
-                                " contrast normalisation flags for " + std::to_string(layers.size()) + " layers");
   layers_.reserve(layers.size());
-  for (std::size_t i = 0; i < layers.size(); ++i) {
-    const std::string& name = layers[i];
-    const bool normalised = i < contrastNormalised.size() && contrastNormalised[i];
-    const bool squared = squaredAll || normalised;
+  for (const std::string& name : layers) {
     const Layer* l = stack.find(name);
     if (!l && name == layer::kHueDistance && stack.has(layer::kHue)) {
       if (!referenceHue)
@@ -80,19 +61,12 @@ IntegralStack::IntegralStack(const LayerStack& stack, std::span<const std::strin
       const Layer& hueLayer = stack.at(layer::kHue);
       cv::Mat hue = hueLayer.data;
       if (hue.type() != CV_32FC1) hue.convertTo(hue, CV_32F);
-      layers_.push_back(integrateLayer(name, hueDistanceLayer(hue, hueLayer.valid, *referenceHue), squared));
-    } else {
-      if (!l) stack.at(name);  // throws, naming the missing layer and the ones present
-      layers_.push_back(integrateLayer(name, l->data, squared));
+      layers_.push_back(integrateLayer(name, hueDistanceLayer(hue, hueLayer.valid, *referenceHue)));
+      continue;
     }
-    layers_.back().contrastNormalised = normalised;
+    if (!l) stack.at(name);  // throws, naming the missing layer and the ones present
+    layers_.push_back(integrateLayer(name, l->data));
   }
-}
-
-std::vector<bool> IntegralStack::contrastNormalised() const {
-  std::vector<bool> out;
-  for (const LayerIntegral& l : layers_) out.push_back(l.contrastNormalised);
-  return out;
 }
 
 }  // namespace fusedet::boosting

@@ -75,6 +75,7 @@ struct RemovedVersion {
   const char* option;
 };
 constexpr RemovedVersion kRemovedVersions[] = {
+    {2, "contrast normalisation"},
     {3, "soft cascade"},
     {4, "side-view (aspect) cascades"},
     {5, "tree weak learners"},
@@ -92,19 +93,12 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   }
   std::ostringstream o;
   o << "{\n";
-  std::vector<std::string> normalised;
-  for (std::size_t l = 0; l < c.layers.size(); ++l)
-    if (c.isContrastNormalised(l)) normalised.push_back(c.layers[l]);
   o << "  \"format\": " << Json(kModelFormatName).dump() << ",\n";
-  // Such a model must not load in a build that would ignore the field and decide differently;
-  // every other model keeps its bytes.
-  // Version 1 unless a layer is contrast-normalised (2).
-  o << "  \"version\": " << (normalised.empty() ? 1 : 2) << ",\n";
+  o << "  \"version\": " << kModelFormatVersion << ",\n";
   o << "  \"class\": " << Json(c.className).dump() << ",\n";
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
-  if (!normalised.empty()) o << "  \"contrast_normalised\": " << Json(normalised).dump() << ",\n";
   if (c.minHeight > 0) o << "  \"min_height\": " << c.minHeight << ",\n";  // optional: older files lack it
   if (!info.empty()) {
     Json t = Json::object();
@@ -153,8 +147,8 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
       r.fail("version", "model format version " + std::to_string(version) + " (" + removed.option +
                             ") was removed in fusedet 0.1.0 (the option measured no gain across "
                             "drives); retrain the model with `fusedet train`");
-  if (version < 1 || version > kModelFormatVersion)
-    r.fail("version", "unsupported version " + std::to_string(version) + " (this build reads 1 to " +
+  if (version != kModelFormatVersion)
+    r.fail("version", "unsupported version " + std::to_string(version) + " (this build reads " +
                           std::to_string(kModelFormatVersion) + ")");
   Cascade c;
   c.source = source;
@@ -173,22 +167,6 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   }
   const Json& hue = r.field(root, "", "reference_hue");
   if (!hue.is_null()) c.referenceHue = r.number(root, "", "reference_hue");
-  // Optional (absent in version 1 files: no layer is normalised, the decisions stay as before).
-  if (root.contains("contrast_normalised")) {
-    const Json& cn = r.array(root, "", "contrast_normalised");
-    c.contrastNormalised.assign(c.layers.size(), false);
-    for (std::size_t i = 0; i < cn.size(); ++i) {
-      const std::string at = Reader::at("contrast_normalised", i);
-      if (!cn[i].is_string()) r.fail(at, "expected a layer name (string), got " + Reader::typeName(cn[i]));
-      const std::string name = cn[i].get<std::string>();
-      const auto li = std::find(c.layers.begin(), c.layers.end(), name);
-      if (li == c.layers.end()) r.fail(at, "layer '" + name + "' is not in \"layers\"");
-      const auto l = static_cast<std::size_t>(li - c.layers.begin());
-      if (c.contrastNormalised[l]) r.fail(at, "layer '" + name + "' listed twice");
-      c.contrastNormalised[l] = true;
-    }
-    if (cn.empty()) c.contrastNormalised.clear();
-  }
   if (root.contains("min_height")) c.minHeight = r.integer(root, "", "min_height", 0, 1 << 16);
   const Json& stages = r.array(root, "", "stages");
   if (stages.empty()) r.fail("stages", "no stages");

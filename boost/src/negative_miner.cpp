@@ -5,7 +5,6 @@
 #include <tbb/task_arena.h>
 
 #include <random>
-#include <stdexcept>
 
 #include "scalar_scan.h"
 #include "window_scanner.h"
@@ -80,7 +79,6 @@ NegativeMiner::~NegativeMiner() = default;
 bool NegativeMiner::extends(const Cascade& c) const {
   if (!started_ || c.windowWidth != applied_.windowWidth || c.windowHeight != applied_.windowHeight ||
       c.layers != applied_.layers || c.referenceHue != applied_.referenceHue ||
-      c.contrastNormalised != applied_.contrastNormalised ||
       c.stages.size() < applied_.stages.size())
     return false;
   for (std::size_t i = 0; i < applied_.stages.size(); ++i)
@@ -125,19 +123,11 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
   forEachStack(n, threads, [&](std::size_t s) {
     if (!mine(s)) return;
     const IntegralStack& in = stacks_.integrals(s);
-    for (std::size_t l = 0; l < in.size(); ++l)  // the squared sums must be there
-      if (in.layer(l).contrastNormalised != cascade.isContrastNormalised(l))
-        throw std::invalid_argument("negative mining: layer '" + in.layer(l).name +
-                                    "' is contrast-normalised in the model or the training stacks, not both");
     const std::vector<ScalePlan> plans = planScales(fresh, in, params);
     const ScanOrder order(scales_[s]);
     const std::size_t nl = in.size();
-    std::vector<const double*> layerData(nl), base(nl), sqData(nl), sqBase(nl);
-    for (std::size_t l = 0; l < nl; ++l) {
-      layerData[l] = in.layer(l).sum.data();
-      sqData[l] = in.layer(l).sqsum.data();  // contrast-normalised layers only
-    }
-    std::vector<double> contrast(nl, 1.0);
+    std::vector<const double*> layerData(nl), base(nl);
+    for (std::size_t l = 0; l < nl; ++l) layerData[l] = in.layer(l).sum.data();
     std::size_t stumps = 0;
     std::vector<std::uint32_t>& alive = alive_[s];
     std::size_t kept = 0;
@@ -145,10 +135,7 @@ void NegativeMiner::update(const Cascade& cascade, int threads) {
       const WindowIndex w = order.at(k);
       const ScalePlan& sp = plans[w.scale];
       for (std::size_t l = 0; l < nl; ++l) base[l] = layerData[l] + sp.rowOfs[l][w.row] + sp.colOfs[l][w.column];
-      for (const ScalePlan::Contrast& c : sp.contrasts)
-        sqBase[c.layer] = sqData[c.layer] + sp.rowOfs[c.layer][w.row] + sp.colOfs[c.layer][w.column];
-      windowContrasts(sp, base.data(), sqBase.data(), contrast.data());
-      if (runWindow(sp, base.data(), contrast.data(), stumps).accepted) alive[kept++] = k;
+      if (runWindow(sp, base.data(), stumps).accepted) alive[kept++] = k;
     }
     alive.resize(kept);
   });

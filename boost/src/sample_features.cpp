@@ -17,15 +17,11 @@ SampleFeatures::SampleFeatures(const TrainingStacks& stacks, std::span<const Fea
   // Layer count of the samples' own stacks (in a sharded job other ranks' stacks are empty).
   layers_ = n ? stacks.integrals(samples[0].stack).size() : 0;
   windows_.resize(n * layers_);
-  contrast_.assign(n * layers_, 1.0);
   for (std::size_t i = 0; i < n; ++i) {
     const IntegralStack& is = stacks.integrals(samples[i].stack);
     if (is.size() != layers_) throw std::invalid_argument("SampleFeatures: stacks differ in layer count");
-    for (std::size_t l = 0; l < layers_; ++l) {
-      const LayerWindow lw = layerWindow(is.layer(l), is.width(), is.height(), samples[i].window);
-      windows_[i * layers_ + l] = lw;
-      if (is.layer(l).contrastNormalised) contrast_[i * layers_ + l] = windowContrast(is.layer(l), lw);
-    }
+    for (std::size_t l = 0; l < layers_; ++l)
+      windows_[i * layers_ + l] = layerWindow(is.layer(l), is.width(), is.height(), samples[i].window);
   }
   auto sizeLess = [&](std::size_t a, std::size_t b) {
     for (std::size_t l = 0; l < layers_; ++l) {
@@ -76,8 +72,7 @@ void SampleFeatures::block(std::size_t first, std::size_t count, std::span<float
         const double black = l.blackCount == 2 ? rs(0) + rs(1) : rs(0);
         const double last = rs(l.blackCount);
         const double white = l.whiteIsRest ? last - black : last;
-        const double value = black / l.blackArea - white / l.whiteArea;
-        dst[k * rowStride + i] = static_cast<float>(li.contrastNormalised ? value / contrast_[i * layers_ + layer] : value);
+        dst[k * rowStride + i] = static_cast<float>(black / l.blackArea - white / l.whiteArea);
       }
     }
   }

@@ -35,10 +35,6 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
       for (int y : sp.ys)
         sp.rowOfs[l].push_back(std::ptrdiff_t(std::clamp(roundHalfUp(y * sy), 0, li.height - lwSize[l][1])) *
                                li.stride());
-      if (c.isContrastNormalised(l)) {
-        const std::int32_t w = lwSize[l][0], h = lwSize[l][1], hs = static_cast<std::int32_t>(h * li.stride());
-        sp.contrasts.push_back({l, {0, w, hs, hs + w}, double(w) * double(h)});
-      }
     }
     for (const Stage& st : c.stages) {
       ScaledStage ss{sp.stumps.size(), 0, st.threshold};
@@ -62,7 +58,6 @@ std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, con
         z.ofs[2] = corners(lay.rects[static_cast<std::size_t>(lay.blackCount)]);
         z.threshold = static_cast<float>(t.threshold);
         z.leaf = {t.left, t.right};
-        z.normalised = c.isContrastNormalised(l);
         sp.stumps.push_back(z);
       }
       ss.end = sp.stumps.size();

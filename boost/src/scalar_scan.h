@@ -29,7 +29,6 @@ struct ScaledStump {
   double blackArea = 1, whiteArea = 1;
   float threshold = 0;
   std::array<double, 2> leaf{};  // left, right: indexed, not branched on
-  bool normalised = false;       // divided by the window's contrast of its layer (feature.h)
 };
 
 struct ScaledStage {
@@ -41,13 +40,6 @@ struct ScalePlan {
   int winW = 0, winH = 0, step = 1;
   std::vector<int> xs, ys;                       // window positions (reference pixels)
   std::vector<std::vector<std::ptrdiff_t>> colOfs, rowOfs;  // per layer, per position
-  // Per contrast-normalised layer: the layer window's corners and area (windowContrast()).
-  struct Contrast {
-    std::size_t layer = 0;
-    std::array<std::int32_t, 4> ofs{};
-    double area = 1;
-  };
-  std::vector<Contrast> contrasts;
   std::vector<ScaledStump> stumps;
   std::vector<ScaledStage> stages;
 };
@@ -55,20 +47,8 @@ struct ScalePlan {
 // Plans of every scale windowScales() gives for `c` on `in` (our models only).
 std::vector<ScalePlan> planScales(const Cascade& c, const IntegralStack& in, const ScanParams& p);
 
-// Contrasts of the window's normalised layers into contrast[layer] (windowContrast()'s sums).
-// sqBase: the layers' squared-sum tables at the window's origin.
-inline void windowContrasts(const ScalePlan& sp, const double* const* base, const double* const* sqBase,
-                            double* contrast) {
-  for (const ScalePlan::Contrast& k : sp.contrasts) {
-    auto rs = [&k](const double* p) { return p[k.ofs[3]] - p[k.ofs[1]] - p[k.ofs[2]] + p[k.ofs[0]]; };
-    contrast[k.layer] = contrastStdDev(rs(base[k.layer]), rs(sqBase[k.layer]), k.area);
-  }
-}
-
 // The hot loop: same arithmetic, in the same order, as featureValue() + evaluateWindow().
-// contrast: per layer, windowContrasts() of this window (read for normalised stumps only).
-inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, const double* contrast,
-                              std::size_t& stumps) {
+inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, std::size_t& stumps) {
   WindowResult r;
   for (const ScaledStage& st : sp.stages) {
     double sum = 0;
@@ -78,8 +58,7 @@ inline WindowResult runWindow(const ScalePlan& sp, const double* const* base, co
       auto rs = [p](const std::array<std::int32_t, 4>& o) { return p[o[3]] - p[o[1]] - p[o[2]] + p[o[0]]; };
       const double black = rs(z.ofs[0]) + rs(z.ofs[1]);
       const double white = rs(z.ofs[2]) - z.rest * black;
-      const double value = black / z.blackArea - white / z.whiteArea;
-      const auto v = static_cast<float>(z.normalised ? value / contrast[z.layer] : value);
+      const auto v = static_cast<float>(black / z.blackArea - white / z.whiteArea);
       sum += z.leaf[static_cast<std::size_t>(!(v < z.threshold))];
     }
     stumps += st.end - st.begin;

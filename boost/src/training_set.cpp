@@ -88,7 +88,7 @@ DatasetItem flipItem(const DatasetItem& item) {
 TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                const std::vector<std::string>& layers,
                                std::optional<double> referenceHue, const SampleConfig& config, Shard shard,
-                               const std::vector<bool>& contrastNormalised, int threads)
+                               int threads)
     : config_(config), shard_(shard) {
   // Stacks: the items, then mirrored copies of the items holding positives. Labels, owners and
   // positives (with the jitter draws) in that order, serially; the integrals in parallel.
@@ -120,8 +120,8 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
     const auto [i, mirrored] = source[k];
     if (!shard_.owns(i)) return;
     try {
-      integrals_[k] = mirrored ? IntegralStack(flipItem(items[i]).stack, layers, referenceHue, false, contrastNormalised)
-                               : IntegralStack(items[i].stack, layers, referenceHue, false, contrastNormalised);
+      integrals_[k] = mirrored ? IntegralStack(flipItem(items[i]).stack, layers, referenceHue)
+                               : IntegralStack(items[i].stack, layers, referenceHue);
     } catch (const std::exception& e) {
       throw std::runtime_error("training item " + (mirrored ? items[i].id + "#flipped" : items[i].id) + ": " +
                                e.what());

@@ -43,14 +43,13 @@ struct GridStump {
   SharedEdge shared = SharedEdge::kNone;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
-  // The vector paths' quick form (stumps on layers that are not contrast-normalised): value' =
+  // The vector paths' quick form: value' =
   // black * invBlackArea - white * invWhiteArea differs from the exact value (divisions) by less
   // than kQuickMargin(value'), and the exact value rounded to float is below `threshold` iff the
   // exact value is below `cut` (float_cut.h). So where |value' - cut| exceeds the margin, value' <
   // cut is the stump's decision; the rare windows closer than that are computed exactly.
   double invBlackArea = 1, invWhiteArea = 1, cut = 0;
   float threshold = 0;
-  int contrast = -1;  // contrast-normalised: index into GridScale::contrasts, else -1 (fills padding)
   double left = 0, right = 0;
 };
 
@@ -64,16 +63,6 @@ constexpr double kQuickMarginRelative = 0x1p-49;
 constexpr double kQuickMarginAbsolute = 0x1p-1000;
 
 std::atomic<bool> gQuickDecisions{true};
-
-// The contrast (feature.h: windowContrast) of one normalised layer on a window: the layer window's
-// corners as offsets from the window's origin in the grid of the layer's sums and in the (double)
-// grid of its squared sums.
-struct GridContrast {
-  int grid = 0, sqGrid = 0;
-  bool intGrid = false;
-  std::array<std::int32_t, 4> ofs{}, sqOfs{};
-  double area = 1;
-};
 
 constexpr int kSpanStride = 3;
 
@@ -92,15 +81,14 @@ struct GridScale {
   std::vector<int> colStride;
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
-  std::vector<GridContrast> contrasts;  // one per contrast-normalised layer the stumps read
   // kQuickMarginRelative, or +inf when quick decisions are off (setQuickStumpDecisions): then no
   // lane is ever sure and every stump takes the exact fallback.
   double quickMarginRelative = kQuickMarginRelative;
 };
 
-// slots[l]: where layer l's sums live; sqSlots[l]: its squared sums (contrast-normalised layers).
+// slots[l]: where layer l's sums live.
 GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector<SlotRef>& slots,
-                    const std::vector<SlotRef>& sqSlots, ScaleWindows win) {
+                    ScaleWindows win) {
   GridScale sp;
   if (!gQuickDecisions.load(std::memory_order_relaxed)) sp.quickMarginRelative = std::numeric_limits<double>::infinity();
   const int W = in.refWidth(), H = in.refHeight();
@@ -132,28 +120,6 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
     for (int y : win.ys)
       sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
-  }
-  // Contrast of each normalised layer: corners of its whole layer window in both tables.
-  std::vector<int> contrastOf(c.layers.size(), -1);
-  for (std::size_t l = 0; l < c.layers.size(); ++l) {
-    if (!c.isContrastNormalised(l)) continue;
-    const SlotRef ref = slots[l], sq = sqSlots[l];
-    const IntegralGrid &gr = in.grids()[static_cast<std::size_t>(ref.grid)], &gq = in.grids()[static_cast<std::size_t>(sq.grid)];
-    const auto& lw = lwSize[static_cast<std::size_t>(ref.grid)];
-    auto corners = [&lw](std::ptrdiff_t slot0, std::ptrdiff_t pitch) {
-      return std::array<std::int32_t, 4>{static_cast<std::int32_t>(slot0), static_cast<std::int32_t>(slot0 + lw[0]),
-                                         static_cast<std::int32_t>(slot0 + lw[1] * pitch),
-                                         static_cast<std::int32_t>(slot0 + lw[1] * pitch + lw[0])};
-    };
-    GridContrast k;
-    k.grid = ref.grid;
-    k.sqGrid = sq.grid;
-    k.intGrid = gr.exactInt;
-    k.ofs = corners(ref.slot * gr.stride, gr.pitch);
-    k.sqOfs = corners(sq.slot * gq.stride, gq.pitch);
-    k.area = double(lw[0]) * double(lw[1]);
-    contrastOf[l] = static_cast<int>(sp.contrasts.size());
-    sp.contrasts.push_back(k);
   }
   for (const Stage& st : c.stages) {
     GridStage gs{static_cast<std::uint32_t>(sp.stumps.size()), 0, st.threshold};
@@ -190,7 +156,6 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       z.cut = floatCut(z.threshold);
       z.left = t.left;
       z.right = t.right;
-      z.contrast = contrastOf[static_cast<std::size_t>(f.layer)];
       sp.stumps.push_back(z);
     }
     gs.end = static_cast<std::uint32_t>(sp.stumps.size());
@@ -205,37 +170,27 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
 // window so that vector lanes past the end read inside the grids.
 struct WindowList {
   static constexpr std::size_t kPad = 8;  // the widest vector path's lanes
-  std::size_t cap = 0, grids = 0, contrasts = 0;
+  std::size_t cap = 0, grids = 0;
   std::vector<std::int32_t> off;  // grids x cap
   std::vector<std::int32_t> xi, yi;
   std::vector<double> score;
-  std::vector<double> contrast;  // contrasts x cap: each window's GridScale::contrasts values
-  void reserve(std::size_t windows, std::size_t nGrids, std::size_t nContrasts) {
+  void reserve(std::size_t windows, std::size_t nGrids) {
     cap = windows + kPad;
     grids = nGrids;
-    contrasts = nContrasts;
     off.assign(cap * grids, 0);
     xi.assign(cap, 0);
     yi.assign(cap, 0);
     score.assign(cap, 0);
-    contrast.assign(cap * contrasts, 1.0);
   }
   std::int32_t* offsets(std::size_t g) { return off.data() + g * cap; }
-  double* contrastOf(std::size_t k) { return contrast.data() + k * cap; }
   // Inlined into the vector loops: an out-of-line call from there into baseline (SSE) code costs a
   // vector-state transition per stage.
   [[gnu::always_inline]] inline void pad(std::size_t n) {
     for (std::size_t g = 0; g < grids; ++g)
       for (std::size_t k = n; k < n + kPad; ++k) offsets(g)[k] = n ? offsets(g)[0] : 0;
-    for (std::size_t c = 0; c < contrasts; ++c)
-      for (std::size_t k = n; k < n + kPad; ++k) contrastOf(c)[k] = 1.0;
   }
-  // kContrast: the windows carry contrasts (models without any skip the loop in the hot path).
-  template <bool kContrast = true>
   void keep(std::size_t from, std::size_t to, double s) {
     for (std::size_t g = 0; g < grids; ++g) offsets(g)[to] = offsets(g)[from];
-    if constexpr (kContrast)
-      for (std::size_t c = 0; c < contrasts; ++c) contrastOf(c)[to] = contrastOf(c)[from];
     xi[to] = xi[from];
     yi[to] = yi[from];
     score[to] = s;
@@ -262,19 +217,6 @@ inline double stumpValue(const GridStump& z, const T* p) {
   return black / z.blackArea - white / z.whiteArea;
 }
 
-// Contrasts of window i of the list (origins set), one window at a time: windowContrast()'s sums.
-void windowContrasts(const GridScale& sp, const void* const* grids, WindowList& l, std::size_t i) {
-  for (std::size_t c = 0; c < sp.contrasts.size(); ++c) {
-    const GridContrast& k = sp.contrasts[c];
-    const std::int32_t o = l.offsets(static_cast<std::size_t>(k.grid))[i];
-    const double sum = k.intGrid ? rectSum(static_cast<const std::int32_t*>(grids[k.grid]) + o, k.ofs)
-                                 : rectSum(static_cast<const double*>(grids[k.grid]) + o, k.ofs);
-    const double sq = rectSum(static_cast<const double*>(grids[k.sqGrid]) + l.offsets(static_cast<std::size_t>(k.sqGrid))[i],
-                              k.sqOfs);
-    l.contrastOf(c)[i] = contrastStdDev(sum, sq, k.area);
-  }
-}
-
 // One stage on windows [0, n) of the list, one window at a time; keeps those that pass.
 std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* const* grids, WindowList& l,
                         std::size_t n) {
@@ -284,9 +226,8 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
     for (std::uint32_t k = st.begin; k < st.end; ++k) {
       const GridStump& z = sp.stumps[k];
       const std::int32_t o = l.offsets(static_cast<std::size_t>(z.grid))[i];
-      double value = z.intGrid ? stumpValue(z, static_cast<const std::int32_t*>(grids[z.grid]) + o)
-                               : stumpValue(z, static_cast<const double*>(grids[z.grid]) + o);
-      if (z.contrast >= 0) value = value / l.contrastOf(static_cast<std::size_t>(z.contrast))[i];
+      const double value = z.intGrid ? stumpValue(z, static_cast<const std::int32_t*>(grids[z.grid]) + o)
+                                     : stumpValue(z, static_cast<const double*>(grids[z.grid]) + o);
       const auto v = static_cast<float>(value);
       sum += v < z.threshold ? z.left : z.right;
     }
@@ -298,7 +239,6 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
 
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
 constexpr std::size_t kMaxVectorGrids = 8;
-constexpr std::size_t kMaxVectorContrasts = 16;  // contrast-normalised layers of one model
 
 // The vector stage loops (vector_stages.inc) are written once against a `Lanes` type - the vector
 // width and its operations - and compiled once per instruction set, each copy under its own target
@@ -383,9 +323,6 @@ struct Lanes {
   static Doubles sub(Doubles a, Doubles b) { return _mm256_sub_pd(a, b); }
   static Doubles div(Doubles a, Doubles b) { return _mm256_div_pd(a, b); }
   static Doubles mul(Doubles a, Doubles b) { return _mm256_mul_pd(a, b); }
-  static Doubles sqrt(Doubles a) { return _mm256_sqrt_pd(a); }
-  static Doubles max(Doubles a, Doubles b) { return _mm256_max_pd(a, b); }
-  static Doubles load(const double* p) { return _mm256_loadu_pd(p); }
   static Doubles roundToFloat(Doubles v) { return _mm256_cvtps_pd(_mm256_cvtpd_ps(v)); }
   static Doubles abs(Doubles v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
   // Per-lane truth values: all bits of a lane set where true.
@@ -458,9 +395,6 @@ struct Lanes {
   static Doubles sub(Doubles a, Doubles b) { return _mm512_sub_pd(a, b); }
   static Doubles div(Doubles a, Doubles b) { return _mm512_div_pd(a, b); }
   static Doubles mul(Doubles a, Doubles b) { return _mm512_mul_pd(a, b); }
-  static Doubles sqrt(Doubles a) { return _mm512_sqrt_pd(a); }
-  static Doubles max(Doubles a, Doubles b) { return _mm512_max_pd(a, b); }
-  static Doubles load(const double* p) { return _mm512_loadu_pd(p); }
   static Doubles roundToFloat(Doubles v) { return _mm512_cvtps_pd(_mm512_cvtpd_ps(v)); }
   static Doubles abs(Doubles v) { return _mm512_abs_pd(v); }
   using Mask = __mmask8;
@@ -499,7 +433,6 @@ std::size_t firstStageScalar(const GridScale& sp, const void* const* grids, std:
       for (std::size_t g = 0; g < l.grids; ++g) l.offsets(g)[n] = sp.rowOfs[g][yi] + sp.colOfs[g][xi];
       l.xi[n] = static_cast<std::int32_t>(xi);
       l.yi[n] = static_cast<std::int32_t>(yi);
-      windowContrasts(sp, grids, l, n);
     }
   l.pad(n);
   return stageScalar(sp, sp.stages.front(), grids, l, n);
@@ -526,26 +459,17 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
               std::size_t y0, std::size_t y1, int scaleIndex, WindowList& l, std::vector<RawHit>& hits,
               std::size_t& stumps) {
   const std::size_t windows = (x1 - x0) * (y1 - y0);
-  const std::size_t nk = sp.contrasts.size();
-  if (l.cap < windows + WindowList::kPad || l.grids != ng || l.contrast.size() < l.cap * nk)
-    l.reserve(windows, ng, nk);
-  l.contrasts = nk;  // models of one scan differ; the buffer holds the most any had
+  if (l.cap < windows + WindowList::kPad || l.grids != ng) l.reserve(windows, ng);
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-  const int lanes = nk > kMaxVectorContrasts ? 1 : vectorLanes(ng);
+  const int lanes = vectorLanes(ng);
 #else
   const int lanes = 1;
 #endif
   stumps += windows * (sp.stages.front().end - sp.stages.front().begin);
   std::size_t n = 0;
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
-  // Models without contrast-normalised layers run the loops without any contrast code.
-  const bool contrast = nk > 0;
-  if (lanes == 8)
-    n = contrast ? avx512::firstStage<true>(sp, grids, x0, x1, y0, y1, l)
-                 : avx512::firstStage<false>(sp, grids, x0, x1, y0, y1, l);
-  if (lanes == 4)
-    n = contrast ? avx2::firstStage<true>(sp, grids, x0, x1, y0, y1, l)
-                 : avx2::firstStage<false>(sp, grids, x0, x1, y0, y1, l);
+  if (lanes == 8) n = avx512::firstStage(sp, grids, x0, x1, y0, y1, l);
+  if (lanes == 4) n = avx2::firstStage(sp, grids, x0, x1, y0, y1, l);
 #endif
   if (lanes == 1) n = firstStageScalar(sp, grids, x0, x1, y0, y1, l);
   for (std::size_t s = 1; s < sp.stages.size() && n > 0; ++s) {
@@ -553,11 +477,11 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
     stumps += n * (st.end - st.begin);
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
     if (lanes == 8) {
-      n = contrast ? avx512::laterStage<true>(sp, st, grids, l, n) : avx512::laterStage<false>(sp, st, grids, l, n);
+      n = avx512::laterStage(sp, st, grids, l, n);
       continue;
     }
     if (lanes == 4) {
-      n = contrast ? avx2::laterStage<true>(sp, st, grids, l, n) : avx2::laterStage<false>(sp, st, grids, l, n);
+      n = avx2::laterStage(sp, st, grids, l, n);
       continue;
     }
 #endif
@@ -601,12 +525,8 @@ std::vector<ScaleWindows> windowScales(const Cascade& c, int W, int H, const Sca
 
 std::vector<LayerRequest> layerRequests(const Cascade& c) {
   std::vector<LayerRequest> out;
-  for (std::size_t l = 0; l < c.layers.size(); ++l) {
-    const std::string& name = c.layers[l];
-    const std::optional<double> hue = name == layer::kHueDistance ? c.referenceHue : std::nullopt;
-    out.push_back(LayerRequest{name, hue, false});
-    if (c.isContrastNormalised(l)) out.push_back(LayerRequest{name, hue, true});
-  }
+  for (const std::string& name : c.layers)
+    out.push_back(LayerRequest{name, name == layer::kHueDistance ? c.referenceHue : std::nullopt});
   return out;
 }
 
@@ -620,17 +540,12 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   // Plans of every cascade and scale, made by the threads too (the serial part of a scan is what
   // the second core cannot shorten).
   std::vector<std::vector<GridScale>> plans(nc);
-  std::vector<std::vector<SlotRef>> slots(nc), sqSlots(nc);
+  std::vector<std::vector<SlotRef>> slots(nc);
   std::vector<std::pair<std::size_t, std::size_t>> planJobs;
   for (std::size_t c = 0; c < nc; ++c) {
     const Cascade& cc = *cascades[c];
     if (cc.isOpenCv()) throw std::invalid_argument("scanCascades: OpenCV models scan their own pyramid");
-    for (std::size_t l = 0; l < cc.layers.size(); ++l) {
-      const std::string& name = cc.layers[l];
-      const std::optional<double> hue = name == layer::kHueDistance ? cc.referenceHue : std::nullopt;
-      slots[c].push_back(in.find(LayerRequest{name, hue, false}));
-      sqSlots[c].push_back(cc.isContrastNormalised(l) ? in.find(LayerRequest{name, hue, true}) : SlotRef{});
-    }
+    for (const LayerRequest& r : layerRequests(cc)) slots[c].push_back(in.find(r));
     for (ScaleWindows& w : windowScales(cc, in.refWidth(), in.refHeight(), params)) {
       planJobs.emplace_back(c, plans[c].size());
       plans[c].emplace_back().win = std::move(w);
@@ -638,7 +553,7 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   }
   auto plan = [&](std::size_t j) {
     const auto [c, s] = planJobs[j];
-    plans[c][s] = planScale(*cascades[c], in, slots[c], sqSlots[c], std::move(plans[c][s].win));
+    plans[c][s] = planScale(*cascades[c], in, slots[c], std::move(plans[c][s].win));
   };
   if (params.threads == 1) {
     for (std::size_t j = 0; j < planJobs.size(); ++j) plan(j);

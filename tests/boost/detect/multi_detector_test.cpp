@@ -63,21 +63,6 @@ void expectSameHits(const std::vector<RawHit>& got, const std::vector<RawHit>& w
   }
 }
 
-// A contrast-normalised variant of a bundled model (its camera layers divided by each window's
-// standard deviation): the thresholds of stumps on those layers are scaled by 1/32 (a typical
-// window contrast in grey levels) so that the cascade still passes windows deep into its stages.
-Cascade normalisedVariant(Cascade c) {
-  c.contrastNormalised.assign(c.layers.size(), false);
-  for (std::size_t l = 0; l < c.layers.size(); ++l)
-    for (const char* camera : {"red", "green", "blue", "intensity"})
-      if (c.layers[l] == camera) c.contrastNormalised[l] = true;
-  for (Stage& st : c.stages)
-    for (Stump& t : st.stumps)
-      if (c.isContrastNormalised(static_cast<std::size_t>(c.features[static_cast<std::size_t>(t.feature)].layer)))
-        t.threshold /= 32;
-  return c;
-}
-
 }  // namespace
 
 TEST(MultiDetector, AllClassesInOnePassDecideAsEachClassAloneOnRealKittiStacks) {
@@ -414,96 +399,4 @@ TEST(MultiDetector, InvalidModelIsRejectedAtConstruction) {
   models[2].stages[0].threshold = NAN;
   models[2].source = "bad.json";
   EXPECT_THROW(MultiDetector{models}, std::invalid_argument);
-}
-
-// Contrast-normalised models (two normalised, one not, in one pass): the one-pass scanner in its
-// scalar, AVX2 and AVX-512 forms decides as each model alone on the per-class scalar path, whose
-// features are featureValue()'s (checked on its hits with evaluateWindow()).
-TEST(MultiDetector, ContrastNormalisedModelsDecideAsEachAloneInEveryForm) {
-  std::vector<Cascade> models = bundledModels();
-  models[0] = normalisedVariant(models[0]);
-  models[2] = normalisedVariant(models[2]);
-  ASSERT_FALSE(models[0].contrastNormalised.empty());
-  const MultiDetector all(models);
-  ScanParams p;
-  p.scaleFactor = 1.15;
-  std::size_t hits = 0, stumps = 0, windows = 0;
-  for (const LayerStack& s : kittiStacks()) {
-    std::vector<std::vector<RawHit>> want;
-    std::vector<ScanStats> ref(models.size());
-    for (std::size_t i = 0; i < models.size(); ++i) {
-      want.push_back(perClass(models[i], s, p, ref[i]));
-      hits += want.back().size();
-      stumps += ref[i].stumps;
-      windows += ref[i].windows;
-      const IntegralStack in = integrateFor(models[i], s);
-      for (std::size_t k = 0; k < want.back().size(); k += 7) {  // the one-window definition
-        const WindowResult r = evaluateWindow(models[i], in, want.back()[k].box);
-        EXPECT_TRUE(r.accepted);
-        EXPECT_EQ(r.score, want.back()[k].score);
-      }
-    }
-    for (int threads : {1, 2}) {
-      p.threads = threads;
-      setVectorScanEnabled(false);
-      std::vector<ScanStats> st;
-      const auto scalar = all.scan(s, p, &st);
-      setVectorScanEnabled(true);
-      for (int lanes : {8, 4}) {
-        setVectorLanesLimit(lanes);
-        std::vector<ScanStats> vs;
-        const auto vec = all.scan(s, p, &vs);
-        for (std::size_t i = 0; i < models.size(); ++i) {
-          const std::string what = models[i].className + " on " + s.source + ", " + std::to_string(lanes) +
-                                   " lanes, " + std::to_string(threads) + " threads";
-          expectSameHits(vec[i], want[i], what);
-          EXPECT_EQ(vs[i].stumps, ref[i].stumps) << what;
-        }
-      }
-      setVectorLanesLimit(8);
-      for (std::size_t i = 0; i < models.size(); ++i) {
-        expectSameHits(scalar[i], want[i], models[i].className + " scalar");
-        EXPECT_EQ(st[i].stumps, ref[i].stumps);
-      }
-    }
-    // Detector (one model, one pass) takes the same path.
-    expectSameHits(Detector(models[0]).scan(s, p), want[0], "Detector car");
-  }
-  std::printf("contrast-normalised: %zu windows, %zu stumps evaluated, %zu raw hits, identical in every form\n",
-              windows, stumps, hits);
-  // The comparison means something only if windows get past the first stages and some pass all.
-  EXPECT_GT(stumps, 3 * windows);
-  EXPECT_GT(hits, 20u);
-}
-
-// Normalisation changes decisions (the flag is not ignored) and integrals built without it are refused.
-TEST(MultiDetector, ContrastNormalisationIsAppliedAndCheckedAgainstTheIntegrals) {
-  const Cascade plain = bundledModels()[0];
-  Cascade flagged = plain;
-  flagged.contrastNormalised = normalisedVariant(plain).contrastNormalised;  // same thresholds
-  ScanParams p;
-  p.threads = 2;
-  ScanStats a, b;
-  const LayerStack& s = kittiStacks().front();
-  Detector(plain).scan(s, p, &a);
-  Detector(flagged).scan(s, p, &b);
-  EXPECT_NE(a.stumps, b.stumps);
-  EXPECT_THROW(Detector(flagged).scan(integrateFor(plain, s), p), std::invalid_argument);
-  EXPECT_THROW(evaluateWindow(flagged, integrateFor(plain, s), Box{0, 0, 60, 30}), std::invalid_argument);
-}
-
-// The bundled models predate the field: they load as "not normalised", and all-false flags decide
-// exactly as no flags.
-TEST(MultiDetector, ModelsWithoutTheFieldAreNotNormalised) {
-  std::vector<Cascade> models = bundledModels();
-  std::vector<Cascade> explicitFalse = models;
-  for (Cascade& c : explicitFalse) {
-    EXPECT_TRUE(c.contrastNormalised.empty()) << c.source;
-    c.contrastNormalised.assign(c.layers.size(), false);
-  }
-  ScanParams p;
-  p.threads = 2;
-  const LayerStack& s = kittiStacks().back();
-  const auto a = MultiDetector(models).scan(s, p), b = MultiDetector(explicitFalse).scan(s, p);
-  for (std::size_t i = 0; i < models.size(); ++i) expectSameHits(b[i], a[i], models[i].className);
 }

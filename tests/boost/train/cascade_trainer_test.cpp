@@ -503,63 +503,6 @@ TEST(SampleFeatures, EqualsFeatureValueBitForBit) {
   for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(one[i], out[5 * n + i]);
 }
 
-// Contrast-normalised layers: the sample path equals featureValue() on them too (the trainer's
-// values are those detection computes).
-TEST(SampleFeatures, EqualsFeatureValueBitForBitOnContrastNormalisedLayers) {
-  const auto items = twoLayerScenes(310);
-  SampleConfig sc;
-  sc.minPositiveHeight = 20;
-  for (const std::vector<bool>& flags : {std::vector<bool>{true, false}, std::vector<bool>{true, true}}) {
-    const TrainingStacks stacks(items, {"intensity", "distance"}, std::nullopt, sc, Shard{}, flags);
-    ASSERT_TRUE(stacks.integrals(0).layer(0).contrastNormalised);
-    PoolConfig pc;
-    pc.grid = 6;
-    pc.layers = {"intensity", "distance"};
-    const auto pool = generatePool(pc);
-    const std::vector<Sample> samples = positivesAndRandomWindows(stacks, 4);
-    const SampleFeatures sf(stacks, pool, samples);
-    const std::size_t n = samples.size();
-    std::vector<float> out(pool.size() * n);
-    sf.block(0, pool.size(), out);
-    std::size_t mismatches = 0, differs = 0;
-    for (std::size_t k = 0; k < pool.size(); ++k)
-      for (std::size_t i = 0; i < n; ++i) {
-        const float ref = featureValue(stacks.integrals(samples[i].stack), pool[k], samples[i].window);
-        mismatches += std::memcmp(&ref, &out[k * n + i], sizeof ref) != 0;
-      }
-    // Normalised values are not the raw ones (the division happened).
-    const TrainingStacks raw(items, {"intensity", "distance"}, std::nullopt, sc);
-    for (std::size_t i = 0; i < n; ++i)
-      differs += featureValue(raw.integrals(samples[i].stack), pool[0], samples[i].window) != out[i];
-    EXPECT_EQ(mismatches, 0u) << "of " << pool.size() * n;
-    EXPECT_GT(differs, n / 2);
-  }
-}
-
-// Training with contrast normalisation records it in the model (file round trip) and yields a
-// cascade that finds the cars in unseen scenes taken with half the contrast and another offset.
-TEST(CascadeTrainer, ContrastNormalisedTrainingIsRecordedAndSurvivesAGainChange) {
-  const auto items = scenes(12, false);
-  TrainingConfig config = smallConfig();
-  config.pool.contrastNormalised = {"intensity"};
-  NullProgress quiet;
-  TrainingReport report;
-  const Cascade c = trainCascade(config, items, quiet, &report);
-  ASSERT_EQ(c.contrastNormalised, std::vector<bool>{true});
-  const Cascade back = modelFromText(modelToText(c), "n.json");
-  EXPECT_EQ(back.contrastNormalised, c.contrastNormalised);
-  const Found f = findCars(Detector(back), [](DatasetItem& t) {
-    cv::Mat dim;
-    t.stack.at("intensity").data.convertTo(dim, CV_8U, 0.5, 40);
-    t.stack.set(Layer{"intensity", dim, {}});
-  });
-  EXPECT_GE(double(f.found), 0.8 * double(f.cars)) << f.found << " of " << f.cars << "; " << report.stopReason;
-  EXPECT_LT(double(f.hits) / double(f.windows), 0.05);
-  // A layer that is not in the pool is refused.
-  config.pool.contrastNormalised = {"distance"};
-  EXPECT_THROW(trainCascade(config, items, quiet), std::invalid_argument);
-}
-
 // The fold-model cache: the first call trains and writes the model under its key, the second
 // loads it and reports the training time the file recorded (what a run from the cache would have
 // cost without it), not the time of loading.

@@ -86,30 +86,3 @@ TEST(FeaturePool, ParsesTypeSetsAndRejectsBadInput) {
   c.grid = 1;
   EXPECT_THROW(c.validate(), std::invalid_argument);
 }
-
-TEST(FeaturePool, ContrastNormalisationChoice) {
-  const std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue_distance", "distance"};
-  EXPECT_TRUE(parseContrastNormalised("none", layers).empty());
-  EXPECT_TRUE(parseContrastNormalised("", layers).empty());
-  EXPECT_EQ(parseContrastNormalised("camera", layers), (std::vector<std::string>{"red", "green", "blue", "intensity"}));
-  EXPECT_EQ(parseContrastNormalised("camera", {"intensity", "hue_distance"}), std::vector<std::string>{"intensity"});
-  EXPECT_TRUE(parseContrastNormalised("camera", {"distance", "remission"}).empty());
-  EXPECT_EQ(parseContrastNormalised("intensity,distance", layers), (std::vector<std::string>{"intensity", "distance"}));
-  try {
-    parseContrastNormalised("intensity,sonar", layers);
-    ADD_FAILURE() << "no error for a layer outside the pool";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("'sonar' is not a layer of the pool"), std::string::npos) << e.what();
-  }
-  EXPECT_EQ(parseContrastNormalised("intensity,red", {"intensity"}, true), std::vector<std::string>{"intensity"});
-  PoolConfig c;
-  c.layers = {"intensity", "distance"};
-  c.contrastNormalised = {"distance"};
-  EXPECT_EQ(c.contrastFlags(), (std::vector<bool>{false, true}));
-  c.contrastNormalised = {};
-  EXPECT_TRUE(c.contrastFlags().empty());
-  c.contrastNormalised = {"red"};
-  EXPECT_THROW(c.validate(), std::invalid_argument);
-  c.contrastNormalised = {"distance", "distance"};
-  EXPECT_THROW(c.validate(), std::invalid_argument);
-}

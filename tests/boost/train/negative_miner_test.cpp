@@ -168,17 +168,3 @@ TEST(NegativeMiner, LabelTestEqualsTheLabelByLabelRule) {
     EXPECT_LT(negatives, windows.size());
   }
 }
-
-// With a contrast-normalised layer the miner (per-window contrasts from the squared sums) still
-// trains the rescan's model, byte for byte.
-TEST(NegativeMiner, TrainsTheSameContrastNormalisedModelAsTheFullRescan) {
-  TrainingConfig config = smallCarConfig();
-  config.pool.contrastNormalised = {"intensity"};
-  config.maxStages = 4;
-  TrainingReport a, b;
-  const auto [old, fast] = trainBothWays(config, a, b);
-  ASSERT_GE(old.stages.size(), 3u) << a.stopReason;
-  ASSERT_EQ(old.contrastNormalised, (std::vector<bool>{true, false, false}));
-  EXPECT_EQ(modelToText(fast), modelToText(old));
-  EXPECT_EQ(b.stopReason, a.stopReason);
-}

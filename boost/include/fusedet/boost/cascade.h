@@ -9,9 +9,7 @@
 //
 // Two kinds of features, two clearly separated evaluation paths:
 //  - our models (Normalization::kNone): `features` are paper features a-j in unit-square window
-//    coordinates on any layer (feature.h); windows scan the layer stack directly; features on a
-//    layer flagged in `contrastNormalised` are divided by the window's standard deviation of that
-//    layer (Viola-Jones contrast normalisation, feature.h);
+//    coordinates on any layer (feature.h); windows scan the layer stack directly;
 //  - imported OpenCV models (Normalization::kOpenCvVariance): `haarFeatures` are weighted
 //    rectangles in the base window's pixels (upright or 45° tilted), evaluated on OpenCV's image
 //    pyramid of one 8-bit layer with its variance normalisation, for bit-exact parity.
@@ -77,9 +75,6 @@ struct Cascade {
   std::vector<std::string> layers;          // layer names the features index
   std::optional<double> referenceHue;       // degrees, for a "hue_distance" layer
   Normalization normalization = Normalization::kNone;
-  // Per layer (parallel to `layers`; empty = none): our features on that layer are divided by the
-  // window's standard deviation of the layer (feature.h: contrastStdDev). Model files record it.
-  std::vector<bool> contrastNormalised;
   std::vector<Feature> features;          // kNone
   std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
   std::vector<Stage> stages;
@@ -91,9 +86,6 @@ struct Cascade {
   double aspectRatio() const { return double(windowWidth) / double(windowHeight); }
   bool isOpenCv() const { return normalization == Normalization::kOpenCvVariance; }
   bool hasTrees() const;
-  bool isContrastNormalised(std::size_t layer) const {
-    return layer < contrastNormalised.size() && contrastNormalised[layer];
-  }
   std::size_t weakCount() const;  // stumps + trees
   // Adds a feature (our kind) and returns its index for Stump::feature.
   int addFeature(const Feature& f);
@@ -101,9 +93,8 @@ struct Cascade {
   // Throws std::invalid_argument naming `source` and the first problem: no stages, empty stage,
   // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
   // index out of range, hue_distance without a reference hue, OpenCV model without one layer,
-  // contrastNormalised not of the layers' size (or set on an OpenCV model),
-  // trees in one of our models, a tree stage count other than the stage count, a stage mixing stumps
-  // and trees, a tree whose children do not follow their parent.
+  // trees in one of our models, a tree stage count other than the stage count, a stage mixing
+  // stumps and trees, a tree whose children do not follow their parent.
   void validate() const;
 };
 

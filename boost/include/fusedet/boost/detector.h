@@ -67,11 +67,10 @@ IntegralStack integrateFor(const Cascade& cascade, const LayerStack& stack);
 // (opencv_cascade.h) switches every vector path off.
 void setVectorLanesLimit(int lanes);
 
-// The vector paths decide a stump on a layer that is not contrast-normalised with products
-// instead of the feature's divisions wherever the product form is provably on the same side of
-// the threshold, and only the few windows too close to call with the divisions (window_scanner.h).
-// false sends every window through that exact fallback. Process-wide; for tests that compare the
-// two (they decide the same).
+// The vector paths decide a stump with products instead of the feature's divisions wherever the
+// product form is provably on the same side of the threshold, and only the few windows too close
+// to call with the divisions (window_scanner.h). false sends every window through that exact
+// fallback. Process-wide; for tests that compare the two (they decide the same).
 void setQuickStumpDecisions(bool enabled);
 
 class Detector {

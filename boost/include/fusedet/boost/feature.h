@@ -13,14 +13,6 @@
 // by hl = max(round(h * sy), 3) pixels (sx, sy = layer size / reference size) whose origin is
 // round(x * sx), round(y * sy), clamped into the layer. The feature's edges are
 // round(rect * window size) inside that window, widened to at least one pixel per grid cell.
-//
-// Contrast normalisation (Viola & Jones 2001, per layer: LayerIntegral::contrastNormalised): the
-// value is divided by the standard deviation of the layer over that whole integer layer window,
-// from the summed-area table and the table of squares: sigma = sqrt(max(sqsum/n - mean^2,
-// kContrastFloor^2)). The floor (one layer unit: one grey level on 8-bit camera layers) keeps flat
-// windows (sky, road, a saturated wall) from turning their noise into large values; there the
-// value stays the unnormalised one. Computed in double, then divided, then rounded to float; every
-// scanner does exactly these operations (tested bit for bit).
 
 #include <array>
 #include <cstdint>
@@ -77,17 +69,8 @@ std::array<int, 2> layerWindowSize(const LayerIntegral& layer, int refWidth, int
 // Outer pixel rectangle of a feature relative to the origin of a layer window of size w x h.
 PixelRect featureRectInWindow(const Feature& f, int w, int h);
 
-// Smallest standard deviation a contrast-normalised window is divided by (layer units).
-inline constexpr double kContrastFloor = 1.0;
-// Standard deviation of a window of `area` pixels with sum `sum` and sum of squares `sqSum`,
-// floored: sqrt(max(sqSum / area - (sum / area)^2, kContrastFloor^2)).
-double contrastStdDev(double sum, double sqSum, double area);
-// The same for the integer layer window `lw` of a layer with squared sums.
-double windowContrast(const LayerIntegral& layer, const LayerWindow& lw);
-
 // Value of `f` on the window `window` (reference pixels) of `integrals`. Computed in double from
 // the exact sums and rounded to float: the precision stumps compare in (training and detection).
-// On a contrast-normalised layer the double value is divided by windowContrast() before rounding.
 float featureValue(const IntegralStack& integrals, const Feature& f, const Box& window);
 
 // Values of many features on one window (same result as featureValue for each).

@@ -22,15 +22,9 @@ struct PoolConfig {
   int sizeStep = 1;          // cell sizes minCellSize, minCellSize + sizeStep, ...
   std::vector<std::string> layers = {"intensity"};  // pool order = Cascade::layers order
   std::vector<FeatureType> types;                   // empty = all ten (a-j)
-  // Layers (of `layers`) whose features are contrast-normalised (Viola-Jones, feature.h); the
-  // trained model records them (Cascade::contrastNormalised). Empty = none.
-  std::vector<std::string> contrastNormalised;
 
-  // Throws std::invalid_argument for a grid < 2, steps < 1, no layers or duplicate layers, or a
-  // contrast-normalised layer that is not in `layers` (or named twice).
+  // Throws std::invalid_argument for a grid < 2, steps < 1, no layers or duplicate layers.
   void validate() const;
-  // One flag per layer (Cascade::contrastNormalised's form); empty when none is normalised.
-  std::vector<bool> contrastFlags() const;
 };
 
 // The pool, feature-major by layer, then type, then size, then position. Feature::layer indexes
@@ -41,14 +35,6 @@ std::vector<Feature> generatePool(const PoolConfig& config);
 std::size_t poolSize(const PoolConfig& config);
 // Features of one type on one layer.
 std::size_t poolSize(const PoolConfig& config, FeatureType type);
-
-// Parses a contrast normalisation choice against the pool's layers: "none" (or empty) = none,
-// "camera" = the camera's brightness layers in the pool (red, green, blue, intensity: the layers a
-// change of light or exposure scales), or comma-separated layer names, each one of `layers`.
-// Throws std::invalid_argument naming a layer that is not in the pool, or with skipAbsent leaves
-// such names out (one choice for several pools of different layers).
-std::vector<std::string> parseContrastNormalised(const std::string& spec, const std::vector<std::string>& layers,
-                                                 bool skipAbsent = false);
 
 // Parses "abcdefghij"-style letter sets ("a-f", "g-j" and "all" too); throws
 // std::invalid_argument naming the bad letter.

@@ -2,8 +2,7 @@
 // IntegralStack: summed-area tables of the layers of one LayerStack that a model reads, built
 // once per stack (paper §2). Sums are kept in double: exact for 8- and 16-bit layers (every
 // partial sum is an integer below 2^53 up to ~1.4e11 pixels) and for float layers as exact as a
-// double sum can be; squared sums are only built when asked for (variance normalisation) and for
-// layers whose features are contrast-normalised (feature.h).
+// double sum can be.
 
 #include <cstddef>
 #include <optional>
@@ -20,9 +19,6 @@ struct LayerIntegral {
   std::string name;
   int width = 0, height = 0;  // the layer's own pixel grid
   std::vector<double> sum;    // (height + 1) rows of stride() values
-  std::vector<double> sqsum;  // same layout, empty unless squared sums were requested
-  // Features on this layer are divided by the window's standard deviation (feature.h); sqsum is set.
-  bool contrastNormalised = false;
 
   std::ptrdiff_t stride() const { return width + 1; }
   // Sum over the pixels [x0, x1) x [y0, y1) (no bounds check: callers clamp).
@@ -30,14 +26,10 @@ struct LayerIntegral {
     const std::ptrdiff_t s = stride();
     return sum[y1 * s + x1] - sum[y0 * s + x1] - sum[y1 * s + x0] + sum[y0 * s + x0];
   }
-  double rectSqSum(int x0, int y0, int x1, int y1) const {
-    const std::ptrdiff_t s = stride();
-    return sqsum[y1 * s + x1] - sqsum[y0 * s + x1] - sqsum[y1 * s + x0] + sqsum[y0 * s + x0];
-  }
 };
 
 // Builds the summed-area table of one single-channel 8U, 16U or 32F image.
-LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data, bool squared = false);
+LayerIntegral integrateLayer(const std::string& name, const cv::Mat& data);
 
 class IntegralStack {
  public:
@@ -46,18 +38,13 @@ class IntegralStack {
   // "hue_distance" that the stack lacks is derived from its "hue" layer with `referenceHue`
   // (fusedet::hueDistanceLayer). Throws std::out_of_range naming a missing layer and
   // std::invalid_argument when hue_distance is needed without a reference hue.
-  // contrastNormalised (empty, or one flag per layer): those layers get squared sums and their
-  // features are contrast-normalised (Cascade::contrastNormalised).
   IntegralStack(const LayerStack& stack, std::span<const std::string> layers,
-                std::optional<double> referenceHue = std::nullopt, bool squared = false,
-                const std::vector<bool>& contrastNormalised = {});
+                std::optional<double> referenceHue = std::nullopt);
 
   int width() const { return width_; }    // reference grid of the stack
   int height() const { return height_; }
   std::size_t size() const { return layers_.size(); }
   const LayerIntegral& layer(std::size_t i) const { return layers_.at(i); }
-  // Per layer: LayerIntegral::contrastNormalised (what a cascade scanning these must also say).
-  std::vector<bool> contrastNormalised() const;
 
  private:
   std::vector<LayerIntegral> layers_;

@@ -1,6 +1,6 @@
 #pragma once
 // Model files of our cascades: versioned, human-readable JSON (one stump per line), holding the
-// class, window size (aspect ratio), layer names, reference hue, contrast-normalised layers and the stages with their
+// class, window size (aspect ratio), layer names, reference hue and the stages with their
 // thresholds and stumps (feature type letter, unit-square rectangle, layer name, threshold, two
 // leaf values). Writing is deterministic: the same cascade gives the same bytes.
 //
@@ -11,7 +11,6 @@
 //     "window": {"width":40,"height":24},
 //     "layers": ["intensity","distance"],
 //     "reference_hue": 25,
-//     "contrast_normalised": ["intensity"],   (version 2 only; optional; absent = none)
 //     "training": {"seed":"1", ...},          (optional, informative, ignored when loading)
 //     "stages": [
 //       {"threshold":-0.41,"stumps":[
@@ -32,14 +31,11 @@
 
 namespace fusedet::boosting {
 
-// Version 2 adds "contrast_normalised" (layers whose features are divided by the window's
-// standard deviation, feature.h). Models without them are still written as version 1, byte for
-// byte as before.
-// Versions of options that measured no gain across drives were removed with them (issue 29):
-// loading such a file fails with a ModelError naming the version, the option and what to do
-// (retrain with `fusedet train`): versions 3 (soft cascade), 4 (side-view (aspect) cascades) and 5
-// (tree weak learners).
-inline constexpr int kModelFormatVersion = 2;
+// The one version this build reads and writes. Versions 2-5 were written only for options that
+// measured no gain across drives and were removed with them (issue 29): loading such a file fails
+// with a ModelError naming the version, the option and what to do (retrain with `fusedet train`):
+// 2 contrast normalisation, 3 soft cascade, 4 side-view (aspect) cascades, 5 tree weak learners.
+inline constexpr int kModelFormatVersion = 1;
 inline constexpr const char* kModelFormatName = "fusedet-cascade";
 
 // Any problem reading or writing a model: "<file>: <place>: <reason>", e.g.

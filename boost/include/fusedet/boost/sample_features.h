@@ -3,9 +3,7 @@
 // featureValue() (feature.h) does. A feature's pixel layout inside a window depends only on the
 // window's size on each layer, and the bootstrapped negatives come from a few scan scales, so
 // samples are visited grouped by size and each group lays out the features once; each value is
-// then three or four table look-ups (and, on contrast-normalised layers, one division by the
-// window's standard deviation, computed once per sample). A test checks equality with
-// featureValue() bit for bit.
+// then three or four table look-ups. A test checks equality with featureValue() bit for bit.
 
 #include <cstddef>
 #include <span>
@@ -39,7 +37,6 @@ class SampleFeatures {
   std::vector<std::size_t> order_;      // samples sorted by their per-layer window sizes
   std::vector<std::size_t> runStart_;   // start of each group of equal sizes in order_, + end
   std::vector<LayerWindow> windows_;    // per sample x layer
-  std::vector<double> contrast_;        // per sample x layer: windowContrast() of normalised layers
   std::size_t layers_ = 0;
 };
 

@@ -103,12 +103,11 @@ class TrainingStacks {
   // Integrates `layers` of every item (hue_distance derived with referenceHue); stacks holding
   // positives get a mirrored copy when config.flipPositives. Throws when an item lacks a layer.
   // With a shard, only the items this rank owns (and their mirrored copies) are integrated; the
-  // others need only labels and reference size (readDatasetItemLabels()). contrastNormalised
-  // (empty or one flag per layer): those layers' features are contrast-normalised (feature.h).
+  // others need only labels and reference size (readDatasetItemLabels()).
   // threads (1 = the calling thread, 0 = all cores) share the integrals; the result is the same.
   TrainingStacks(const std::vector<DatasetItem>& items, const std::vector<std::string>& layers,
                  std::optional<double> referenceHue, const SampleConfig& config, Shard shard = {},
-                 const std::vector<bool>& contrastNormalised = {}, int threads = 1);
+                 int threads = 1);
 
   std::size_t size() const { return integrals_.size(); }
   const IntegralStack& integrals(std::size_t i) const { return integrals_.at(i); }
