@@ -29,9 +29,9 @@
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/class_detection.h"
 #include "fusedet/boost/class_rules.h"
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/data_split.h"
-#include "fusedet/boost/experiment_plan.h"
+#include "fusedet/experiments/experiment_plan.h"
 #include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/outcomes_file.h"
@@ -162,7 +162,7 @@ std::string foldsText(std::size_t folds, std::size_t drives) {
                          : std::to_string(folds) + " drive-disjoint folds";
 }
 
-// " (bundled: 8, quick: 6)": every preset's value of a field (boost/experiment_plan.h), for --help.
+// " (bundled: 8, quick: 6)": every preset's value of a field (tools/experiments/experiment_plan.h), for --help.
 std::string presets(const std::function<std::string(const boosting::ExperimentPlan&)>& field) {
   std::string s;
   for (const std::string& n : boosting::experimentPlanNames())
@@ -313,7 +313,7 @@ std::vector<bool> truncationLevelsOf(const ExperimentOptions& o, const std::vect
   return out;
 }
 
-// The preset (boost/experiment_plan.h) with the options given on the command line.
+// The preset (tools/experiments/experiment_plan.h) with the options given on the command line.
 boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   boosting::ExperimentPlan p = boosting::experimentPlan(o.preset);
   if (o.grid > 0) p.grid = o.grid;

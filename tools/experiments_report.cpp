@@ -240,7 +240,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
     if (!r.learningFolds.empty()) md << " Folds: " << r.learningFolds << ".";
     if (!r.chain.empty())
       md << " After grouping every point runs **" << r.chain
-         << "**, fitted per fold on that point's own training frames only (boost/cross_validation.h); a fit "
+         << "**, fitted per fold on that point's own training frames only (tools/experiments/cross_validation.h); a fit "
             "needs enough training detections and an unfitted step is the identity: column \"fitted\" = "
             "folds with a fitted box fit / verifier of the folds trained.";
     md << "\n\n";

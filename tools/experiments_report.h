@@ -2,7 +2,7 @@
 // `fusedet experiments`, output side: report.md (cross-drive tables with 95 % bootstrap intervals,
 // the paper's claims judged with paired intervals, learning curves, goals), results.json, and the
 // charts: precision-recall curves and learning curve per class, weight share by layer (Fig. 7).
-// The numbers come from the library (boost/cross_validation.h, bootstrap.h); this only prints.
+// The numbers come from the library (tools/experiments/cross_validation.h, bootstrap.h); this only prints.
 
 #include <filesystem>
 #include <map>
@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "fusedet/boost/bootstrap.h"
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/miss_analysis.h"

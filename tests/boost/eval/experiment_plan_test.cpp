@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "fusedet/boost/experiment_plan.h"
+#include "fusedet/experiments/experiment_plan.h"
 #include "fusedet/boost/gentle_boost.h"
 
 namespace fusedet::boosting {

@@ -8,7 +8,7 @@
 
 #include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/class_rules.h"
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/data_split.h"
 #include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/precision_recall.h"

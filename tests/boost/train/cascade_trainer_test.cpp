@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "fusedet/boost/class_rules.h"
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/validation_part.h"
 #include "fusedet/boost/model_io.h"

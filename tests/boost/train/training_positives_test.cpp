@@ -9,7 +9,7 @@
 
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/class_rules.h"
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/training_set.h"
 #include "synthetic_scenes.h"

@@ -8,7 +8,7 @@
 
 #include <algorithm>
 
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 #include "fusedet/boost/learning_curve.h"
 #include "fusedet/boost/miss_analysis.h"
 #include "synthetic_scenes.h"

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fusedet/boost/box_regression.h"
+#include "fusedet/boost/detection_setup.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/group_verifier.h"
@@ -18,13 +19,6 @@
 
 namespace fusedet::boosting {
 
-struct DetectionSetup {
-  ScanParams scan;
-  GroupParams group;
-  LaserExtentParams laserExtent;  // box refinement after grouping (off by default)
-  BoxRegression boxRegression{};  // learned refinement after the laser extent (none by default)
-  GroupVerifier verifier{};       // learned group verifier after the boxes (none by default)
-};
 
 struct EvalOutcome {
   Counts counts;

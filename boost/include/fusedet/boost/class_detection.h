@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "fusedet/boost/chain_evaluation.h"
+#include "fusedet/boost/detection_setup.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/laser_extent.h"

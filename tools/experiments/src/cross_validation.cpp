@@ -1,4 +1,4 @@
-#include "fusedet/boost/cross_validation.h"
+#include "fusedet/experiments/cross_validation.h"
 
 #include <chrono>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "fusedet/boost/experiment_plan.h"
+#include "fusedet/experiments/experiment_plan.h"
 
 #include <algorithm>
 #include <stdexcept>
