@@ -6,9 +6,11 @@
 #include "fusedet/drivers/usb/usb_match.h"
 #include "fusedet/drivers/v4l2/controls.h"
 
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <type_traits>
 
 namespace fusedet::daemon {
 namespace {
@@ -33,6 +35,9 @@ class Section {
     } catch (const YAML::Exception&) {
       fail(v, std::string("key ") + keyPath(key) + ": wrong type");
     }
+    // yaml-cpp reads .nan and .inf as numbers; no key of this file means either, and a NaN
+    // passes every range check (a NaN scale_factor made every stack fail silently).
+    if (!finite(out)) fail(v, std::string("key ") + keyPath(key) + ": not a finite number");
   }
 
   template <class T>
@@ -66,7 +71,7 @@ class Section {
     if (!n || n.IsNull()) return out;
     if (!n.IsMap()) fail(n, "key " + keyPath(key) + ": expected a mapping");
     for (const auto& kv : n) {
-      const auto name = kv.first.as<std::string>();
+      const std::string name = keyName(kv.first, keyPath(key));
       out.emplace_back(name, Section(kv.second, keyPath(key) + "." + name, source_));
     }
     return out;
@@ -81,7 +86,7 @@ class Section {
   void finish() const {
     if (!node_ || !node_.IsMap()) return;
     for (const auto& kv : node_) {
-      const auto key = kv.first.as<std::string>();
+      const std::string key = keyName(kv.first, path_);
       if (!seen_.count(key)) fail(kv.first, "unknown key " + keyPath(key.c_str()));
     }
   }
@@ -96,6 +101,29 @@ class Section {
 
  private:
   std::string keyPath(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
+
+  // A mapping key as a name. YAML allows sequences, mappings and null as keys (`? [a]: 1`);
+  // converting one to a string throws a yaml-cpp error, so it is refused here by name.
+  std::string keyName(const YAML::Node& key, const std::string& in) const {
+    if (!key.IsScalar()) {
+      const char* what = key.IsSequence() ? "a sequence" : key.IsMap() ? "a mapping" : "null";
+      fail(key, std::string("a key must be a plain name, not ") + what + (in.empty() ? "" : " (in " + in + ")"));
+    }
+    return key.Scalar();
+  }
+
+  template <class T>
+  static bool finite(const T& v) {
+    if constexpr (std::is_floating_point_v<T>) {
+      return std::isfinite(v);
+    } else if constexpr (requires { v.begin(); v.end(); } && !std::is_same_v<T, std::string>) {
+      for (const auto& e : v)
+        if (!finite(e)) return false;
+      return true;
+    } else {
+      return true;
+    }
+  }
 
   YAML::Node node_;
   std::string path_;
@@ -112,13 +140,9 @@ std::vector<Config::Detection::ClassSettings> Config::Detection::builtInClasses(
   return out;
 }
 
-Config parseConfig(const std::string& yamlText, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(yamlText);
-  } catch (const YAML::ParserException& e) {
-    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
-  }
+namespace {
+
+Config parseTree(const YAML::Node& root, const std::string& source) {
   Config c;
   Section top(root, "", source);
   top.readRange("version", c.version, 1, 1);
@@ -234,6 +258,24 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
   }
   top.finish();
   return c;
+}
+
+}  // namespace
+
+Config parseConfig(const std::string& yamlText, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yamlText);
+  } catch (const YAML::ParserException& e) {
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
+  }
+  try {
+    return parseTree(root, source);
+  } catch (const YAML::Exception& e) {
+    // Every read above turns yaml-cpp's errors into ConfigError; this is the net for a case
+    // missed, so that a bad file is a config error (SIGHUP keeps the running config), never a crash.
+    throw ConfigError(source + (e.mark.is_null() ? std::string() : ":" + std::to_string(e.mark.line + 1)) + ": " + e.msg);
+  }
 }
 
 Config loadConfig(const std::filesystem::path& file) {

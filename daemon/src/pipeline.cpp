@@ -16,15 +16,30 @@ Pipeline::Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> det
     : setup_(std::move(setup)),
       onResult_(std::move(onResult)),
       detector_(std::move(detector)),
-      sensorQueue_(setup_.sensorQueueCapacity),
+      sensorQueue_(setup_.sensorQueueCapacity, setup_.sensorQueueBytes, &Pipeline::bytesOf),
       stackQueue_(setup_.stackQueueCapacity),
       assembler_(setup_.sweep),
-      pairer_(setup_.maxPairSkewNs) {
+      pairer_(setup_.maxPairSkewNs, 32, setup_.pairerBytes) {
   if (!setup_.fuser) throw std::invalid_argument("Pipeline: no fuser");
   if (!detector_) throw std::invalid_argument("Pipeline: no detector");
 }
 
 Pipeline::~Pipeline() { stop(std::chrono::steady_clock::now()); }
+
+std::size_t Pipeline::bytesOf(const SensorMessage& message) {
+  struct Size {
+    std::size_t operator()(const drivers::LaserScan& s) const {
+      return sizeof s + (s.ranges.size() + s.remissions.size()) * sizeof(float);
+    }
+    std::size_t operator()(const drivers::TiltSample& t) const { return sizeof t; }
+    std::size_t operator()(const drivers::CameraFrame& f) const { return sizeof f + f.bytes.size(); }
+    std::size_t operator()(const PairedScene& p) const {
+      return sizeof p + p.sweep.points.size() * sizeof(fusion::SweepPoint) + p.frame.bytes.size();
+    }
+    std::size_t operator()(const EndOfStream&) const { return 0; }
+  };
+  return std::visit(Size{}, message);
+}
 
 void Pipeline::start() {
   const std::int64_t now = Stamp::now().ns;

@@ -7,7 +7,7 @@ nlohmann::json vec3(const Eigen::Vector3d& v) { return nlohmann::json::array({v.
 
 }  // namespace
 
-std::optional<Request> parseRequest(std::string_view line, std::string& error) {
+std::optional<Request> parseRequest(std::string_view line, std::string& error, nlohmann::json* id) {
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(line.begin(), line.end());
@@ -21,6 +21,7 @@ std::optional<Request> parseRequest(std::string_view line, std::string& error) {
   }
   Request r;
   if (j.contains("id")) r.id = j["id"];
+  if (id) *id = r.id;
   const auto cmd = j.find("cmd");
   if (cmd == j.end() || !cmd->is_string()) {
     error = "missing \"cmd\" (a string: hello, subscribe, unsubscribe, latest, status)";

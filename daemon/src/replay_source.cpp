@@ -48,6 +48,24 @@ void ReplaySource::record(const drivers::logs::SensorReplayCounters& counters) {
 
 void ReplaySource::run(SensorSink& sink) {
   nameThisThread("fd-replay");
+  // The log may fail under the replay (I/O error, the file shrunk or was replaced): an exception
+  // from the reader must not leave this thread (std::terminate). The replay ends there as a
+  // failed source - status says why - and what was delivered is closed like a log's end.
+  try {
+    replay(sink);
+  } catch (const std::exception& e) {
+    {
+      std::lock_guard lock(mutex_);
+      error_ = std::string("replay failed: ") + e.what();
+    }
+    spdlog::error("replay {}: {}", settings_.log.string(), e.what());
+    failed_ = true;
+    sink.onEndOfStream();
+    finished_ = true;
+  }
+}
+
+void ReplaySource::replay(SensorSink& sink) {
   std::uint64_t delivered = 0;
   std::int64_t newest = 0;  // newest stamp delivered: the next pass is stamped after it
   drivers::logs::SensorReplay::Handlers h;
@@ -103,7 +121,7 @@ void ReplaySource::run(SensorSink& sink) {
 std::vector<SensorHealth> ReplaySource::health() const {
   SensorHealth h;
   h.name = "replay";
-  h.state = finished_ ? "finished" : (stop_ ? "stopped" : "replaying");
+  h.state = failed_ ? "failed" : finished_ ? "finished" : (stop_ ? "stopped" : "replaying");
   std::lock_guard lock(mutex_);
   h.messages = delivered_;
   h.crcErrors = crcErrors_ + pass_.telegrams.crcErrors;  // finished passes + this one

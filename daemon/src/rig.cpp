@@ -26,6 +26,9 @@ fusion::SweepConfig sweepConfig(const Config& c) {
   s.tiltWindowS = c.fusion.tiltWindowMs * 1e-3;
   s.closeOnTilt = c.fusion.closeOnTilt;
   s.remissionFullScale = c.laser.remission ? c.laser.remissionFullScale : 1.0;
+  // A nod takes (max - min) / speed plus the turn; twice that and 2 s more is no nod any longer
+  // (10 s with the defaults): the tilt is parked or stuck and the open sweep is cut.
+  s.maxSweepS = 2.0 * (c.tilt.maxDeg - c.tilt.minDeg) / c.tilt.speedDegS + 2.0;
   return s;
 }
 

@@ -63,15 +63,20 @@ drivers::UniqueFd bindUnixSocket(const std::string& path) {
   auto* sa = reinterpret_cast<sockaddr*>(&addr);
   if (::bind(fd.get(), sa, sizeof addr) < 0) {
     if (errno != EADDRINUSE) throwErrno("bind " + path);
-    // A socket file exists: replace it only if nobody listens on it.
+    // A file exists: replace it only if it is a stale socket - connecting is refused (nobody
+    // listens). Any other answer (EACCES: its owner keeps it from us; EPROTOTYPE: another kind
+    // of socket) means it is not ours to remove.
     drivers::UniqueFd probe(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
+    if (!probe.valid()) throwErrno("socket");
     if (::connect(probe.get(), sa, sizeof addr) == 0)
       throw std::system_error(std::make_error_code(std::errc::address_in_use),
                               path + ": another fusedetd is serving on it");
-    ::unlink(path.c_str());
+    if (errno != ECONNREFUSED)
+      throwErrno(path + ": exists and is not a stale socket (connecting to it failed otherwise than refused), left alone");
+    if (::unlink(path.c_str()) < 0) throwErrno("removing the stale socket " + path);
     if (::bind(fd.get(), sa, sizeof addr) < 0) throwErrno("bind " + path);
   }
-  ::chmod(path.c_str(), 0660);
+  if (::chmod(path.c_str(), 0660) < 0) throwErrno("chmod 0660 " + path);
   if (::listen(fd.get(), 64) < 0) throwErrno("listen " + path);
   return fd;
 }
@@ -283,13 +288,14 @@ void Server::readFrom(Client& c) {
 
 void Server::handleLine(Client& c, std::string_view line) {
   std::string error;
-  const auto request = parseRequest(line, error);
+  nlohmann::json id;
+  const auto request = parseRequest(line, error, &id);
   if (!request) {
     {
       std::lock_guard lock(mutex_);
       ++counters_.badRequests;
     }
-    queue(c, std::make_shared<const std::string>(errorLine(error)));
+    queue(c, std::make_shared<const std::string>(errorLine(error, id)));
     return;
   }
   nlohmann::json reply;

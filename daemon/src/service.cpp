@@ -9,6 +9,18 @@
 #include "fusedet/fusion/camera_model.h"
 
 namespace fusedet::daemon {
+namespace {
+
+// The laser scans while the tilt stands still this long: the motor is parked, stuck or faulted
+// (it pauses only a few ms at each end of a nod).
+constexpr double kTiltStillS = 1.0;
+
+const char* tiltMotion(const fusion::SweepStats& s) {
+  if (s.tiltSamples == 0) return "no samples";
+  return s.tiltStillS >= kTiltStillS ? "still" : "moving";
+}
+
+}  // namespace
 
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile) {
   std::filesystem::path calibration = config.camera.calibration;
@@ -65,12 +77,26 @@ void Service::start() {
   started_ = true;
 }
 
-void Service::stop(std::chrono::steady_clock::time_point deadline) {
-  if (!started_) return;
+std::string Service::stop(std::chrono::steady_clock::time_point deadline) {
+  if (!started_) return {};
   started_ = false;
-  for (auto& s : sources_) s->stop();
+  std::string problems;
+  for (auto& s : sources_) {
+    s->stop();
+    if (std::string p = s->stopProblem(); !p.empty()) problems += (problems.empty() ? "" : "; ") + p;
+  }
+  sourcesStopped_ = true;
   pipeline_->stop(deadline);
   server_->stop(deadline);
+  return problems;
+}
+
+std::chrono::milliseconds Service::stopBudget() const {
+  // The pipeline drains while the sources stop; after the last one it gets a short while more.
+  constexpr std::chrono::milliseconds kAfterSources{300};
+  std::chrono::milliseconds sources{0};
+  for (const auto& s : sources_) sources += s->stopTime();
+  return std::max(kDrainBudget, sources + kAfterSources);
 }
 
 Config Service::config() const {
@@ -83,7 +109,7 @@ std::string Service::reload() {
   Config next;
   try {
     next = loadConfig(configFile_);
-  } catch (const ConfigError& e) {
+  } catch (const std::exception& e) {  // ConfigError, and anything else: a bad file never ends the service
     std::lock_guard lock(mutex_);
     lastReloadError_ = e.what();
     return lastReloadError_;
@@ -161,6 +187,9 @@ nlohmann::json Service::status() const {
        {{"sensor_queue", {{"depth", p.sensorQueue.depth}, {"pushed", p.sensorQueue.pushed}, {"dropped", p.sensorQueue.dropped}}},
         {"stack_queue", {{"depth", p.stackQueue.depth}, {"pushed", p.stackQueue.pushed}, {"dropped", p.stackQueue.dropped}}},
         {"sweeps", p.sweeps.sweeps},
+        {"sweeps_cut", p.sweeps.sweepsCut},
+        {"tilt_motion", tiltMotion(p.sweeps)},
+        {"tilt_still_s", p.sweeps.tiltStillS},
         {"scans_dropped_no_tilt", p.sweeps.scansDroppedNoTilt},
         {"unpaired_sweeps", p.unpaired},
         {"decode_errors", p.decodeErrors},
@@ -189,6 +218,12 @@ bool Service::finished() const {
   for (const auto& s : sources_)
     if (!s->finished()) return false;
   return pipeline_->idle();
+}
+
+bool Service::failed() const {
+  for (const auto& s : sources_)
+    if (s->failed()) return true;
+  return false;
 }
 
 bool Service::alive(std::int64_t maxAgeNs) const { return stalled(maxAgeNs).empty(); }
@@ -220,6 +255,8 @@ std::string Service::summary() const {
       if (h.progress) o << ' ' << static_cast<int>(*h.progress * 100) << '%';
       first = false;
     }
+  if (tiltMotion(p.sweeps) == std::string("still"))
+    o << "; tilt still for " << static_cast<int>(p.sweeps.tiltStillS) << " s (" << p.sweeps.sweepsCut << " sweeps cut)";
   o << "; " << p.stacksDetected << " stacks, " << p.stackQueue.dropped << " dropped; " << s.clients << " clients";
   std::lock_guard lock(mutex_);
   if (!lastReloadError_.empty()) o << "; reload failed: " << lastReloadError_;

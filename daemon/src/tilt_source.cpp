@@ -7,6 +7,9 @@
 #include "fusedet/daemon/thread_info.h"
 
 namespace fusedet::daemon {
+namespace {
+constexpr std::chrono::milliseconds kPoll{20};  // the source's threads look at their flags this often
+}  // namespace
 
 drivers::canopen::TiltDriveConfig tiltDriveConfigFrom(const Config::Tilt& t) {
   drivers::canopen::TiltDriveConfig c;
@@ -64,7 +67,7 @@ void TiltSource::run(SensorSink& sink) {
             std::lock_guard lock(mutex_);
             counters_ = drive.counters();
           }
-          std::this_thread::sleep_for(std::chrono::milliseconds(200));
+          std::this_thread::sleep_for(kPoll);  // short: stop() joins this thread within its budget
         }
       });
       std::atomic<bool> runnerStop{false};
@@ -73,12 +76,22 @@ void TiltSource::run(SensorSink& sink) {
         if (!r) setState("backing off", r.error().message());
         runnerDone = true;
       });
-      while (!stop_ && !runnerDone) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      if (!runnerDone) {
-        // Stopping: bring the motor to rest (the drive needs the runner for that), then end.
+      while (!stop_ && !runnerDone) std::this_thread::sleep_for(kPoll);
+      if (stop_) {
+        // Stopping: bring the motor to rest (the drive needs the runner for that), then end. The
+        // drive ends its stop by config_.stopTimeout(), acknowledged or not; only an
+        // acknowledged one is a motor known to be at rest.
         drive.stop();
-        for (int i = 0; i < 100 && !drive.stopped() && !runnerDone; ++i)
-          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        const auto until = std::chrono::steady_clock::now() + config_.stopTimeout() + kPoll;
+        while (!drive.stopped() && !runnerDone && std::chrono::steady_clock::now() < until)
+          std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        std::lock_guard lock(mutex_);
+        if (!drive.stopConfirmed()) {
+          stopProblem_ = "tilt motor (" + interface_ + " node " + std::to_string(config_.node) +
+                         "): halt and shutdown not acknowledged within " + std::to_string(config_.stopTimeout().count()) +
+                         " ms - it may still be moving";
+          lastError_ = stopProblem_;
+        }
       }
       runnerStop = true;
       runner.join();
@@ -90,6 +103,16 @@ void TiltSource::run(SensorSink& sink) {
     wake_.wait_for(lock, std::chrono::seconds(1), [this] { return stop_.load(); });
   }
   setState("stopped");
+}
+
+std::chrono::milliseconds TiltSource::stopTime() const {
+  // The drive's stop, the wait's poll, the runner's tick and the watcher's poll.
+  return config_.stopTimeout() + 3 * kPoll;
+}
+
+std::string TiltSource::stopProblem() const {
+  std::lock_guard lock(mutex_);
+  return stopProblem_;
 }
 
 std::vector<SensorHealth> TiltSource::health() const {

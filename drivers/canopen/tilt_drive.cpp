@@ -91,21 +91,32 @@ void TiltDrive::hold(double angleRad) {
 void TiltDrive::stop() {
   std::lock_guard lock(mutex_);
   if (phase_ == TiltPhase::kIdle || phase_ == TiltPhase::kStopped) {
+    if (phase_ == TiltPhase::kIdle) stopConfirmed_ = true;  // never started: nothing to bring to rest
     phase_ = TiltPhase::kStopped;
     return;
   }
   ++generation_;
   sdo_.cancelAll(makeError(std::errc::operation_canceled, "stopping"));
   phase_ = TiltPhase::kStopping;
-  phaseDeadline_ = now_ + ns(config_.sdoTimeout) * 3;
+  haltAcked_ = stopConfirmed_ = false;
+  phaseDeadline_ = now_ + ns(config_.stopTimeout());
   const std::uint64_t gen = generation_;
-  auto finish = [this, gen](Result<SdoClient::Bytes>) {
+  auto halted = [this, gen](Result<SdoClient::Bytes> r) {
+    if (gen == generation_ && r) haltAcked_ = true;
+  };
+  auto finish = [this, gen](Result<SdoClient::Bytes> r) {
     if (gen != generation_) return;
     (void)bus_.send(nmtFrame(NmtCommand::kPreOperational, config_.node));
+    stopConfirmed_ = haltAcked_ && static_cast<bool>(r);
     phase_ = TiltPhase::kStopped;
   };
-  sdo_.download(od::kControlword, 0, cw::kEnableOperation | cw::kHalt, 2, {});
+  sdo_.download(od::kControlword, 0, cw::kEnableOperation | cw::kHalt, 2, halted);
   sdo_.download(od::kControlword, 0, cw::kShutdown, 2, finish);
+}
+
+bool TiltDrive::stopConfirmed() const {
+  std::lock_guard lock(mutex_);
+  return phase_ == TiltPhase::kStopped && stopConfirmed_;
 }
 
 TiltPhase TiltDrive::phase() const {

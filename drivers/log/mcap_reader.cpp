@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <memory>
+#include <new>
+#include <span>
 
 #include "mcap_codec.h"
 
@@ -18,6 +21,44 @@ namespace {
 constexpr std::uint64_t kMaxChunkBytes = 1ull << 30;
 
 std::string byteAt(std::uint64_t offset) { return "byte " + std::to_string(offset); }
+
+// zstd data -> exactly `size` bytes. The output grows with what really comes out (doubling from
+// a few times the input), so a corrupt header that claims up to kMaxChunkBytes costs no more
+// memory than the data actually decompresses to.
+std::vector<std::uint8_t> inflate(std::span<const std::uint8_t> data, std::uint64_t size) {
+  std::unique_ptr<ZSTD_DCtx, decltype(&ZSTD_freeDCtx)> ctx(ZSTD_createDCtx(), ZSTD_freeDCtx);
+  if (!ctx) throw std::bad_alloc();
+  std::vector<std::uint8_t> out(static_cast<std::size_t>(std::min<std::uint64_t>(size, std::max<std::uint64_t>(data.size() * 4, 1 << 16))));
+  ZSTD_inBuffer in{data.data(), data.size(), 0};
+  std::size_t produced = 0;
+  std::size_t left = 1;  // ZSTD_decompressStream's hint: 0 = a frame is complete
+  while (in.pos < in.size || left != 0) {
+    if (produced == out.size() && out.size() >= size) {
+      // Full at the claimed size: what is left may only end the frame (its checksum), no data.
+      std::uint8_t extra = 0;
+      ZSTD_outBuffer o{&extra, 1, 0};
+      const std::size_t before = in.pos;
+      left = ZSTD_decompressStream(ctx.get(), &o, &in);
+      if (ZSTD_isError(left)) throw RecordError(std::string("zstd: ") + ZSTD_getErrorName(left));
+      if (o.pos != 0)
+        throw RecordError("zstd data decompresses to more than the " + std::to_string(size) + " bytes the header says");
+      if (in.pos == before) throw RecordError("zstd: data ends inside a frame");
+      continue;
+    }
+    if (produced == out.size()) out.resize(static_cast<std::size_t>(std::min<std::uint64_t>(size, std::uint64_t{out.size()} * 2)));
+    ZSTD_outBuffer o{out.data(), out.size(), produced};
+    const std::size_t before = in.pos;
+    left = ZSTD_decompressStream(ctx.get(), &o, &in);
+    if (ZSTD_isError(left)) throw RecordError(std::string("zstd: ") + ZSTD_getErrorName(left));
+    const bool progress = o.pos != produced || in.pos != before;
+    produced = o.pos;
+    if (!progress && produced < out.size()) throw RecordError("zstd: data ends inside a frame");
+  }
+  if (produced != size)
+    throw RecordError("decompressed to " + std::to_string(produced) + " bytes, header says " + std::to_string(size));
+  out.resize(produced);
+  return out;
+}
 }  // namespace
 
 std::string Truncation::describe() const {
@@ -91,10 +132,7 @@ std::vector<std::uint8_t> McapReader::decompress(const ChunkInfo& c, std::vector
       if (data.size() != size) throw RecordError("uncompressed chunk of " + std::to_string(data.size()) + " bytes claims " + std::to_string(size));
       out.assign(data.begin(), data.end());
     } else if (compression == "zstd") {
-      out.resize(size);
-      const std::size_t n = ZSTD_decompress(out.data(), out.size(), data.data(), data.size());
-      if (ZSTD_isError(n)) throw RecordError(std::string("zstd: ") + ZSTD_getErrorName(n));
-      if (n != size) throw RecordError("decompressed to " + std::to_string(n) + " bytes, header says " + std::to_string(size));
+      out = inflate(data, size);
     } else {
       throw RecordError("unsupported compression '" + compression + "'");
     }

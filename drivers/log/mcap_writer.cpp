@@ -155,7 +155,9 @@ void McapWriter::closeChunk() {
   chunk_.clear();
   chunkMessages_.clear();
   if (std::fflush(file_) != 0) fail(std::string("write error: ") + std::strerror(errno));
-  if (options_.fsyncChunks) ::fdatasync(fileno(file_));
+  // The chunk is only safe from a power cut once this succeeded: an error (EIO, ENOSPC on some
+  // file systems) is a write error like any other.
+  if (options_.fsyncChunks && ::fdatasync(fileno(file_)) != 0) fail(std::string("fdatasync: ") + std::strerror(errno));
 }
 
 void McapWriter::flush() {

@@ -13,11 +13,16 @@ Stamp lastBeamStamp(const drivers::LaserScan& s) {
 }  // namespace
 
 SweepAssembler::SweepAssembler(SweepConfig config)
-    : config_(std::move(config)), windowNs_(static_cast<std::int64_t>(config_.tiltWindowS * 1e9)) {
+    : config_(std::move(config)),
+      windowNs_(static_cast<std::int64_t>(config_.tiltWindowS * 1e9)),
+      maxSweepNs_(static_cast<std::int64_t>(config_.maxSweepS * 1e9)) {
   if (!(config_.tiltAxis.norm() > 0)) throw std::invalid_argument("sweep: tilt axis must not be zero");
   config_.tiltAxis.normalize();
   if (!(config_.tiltWindowS > 0)) throw std::invalid_argument("sweep: tilt window must be > 0");
   if (!(config_.remissionFullScale > 0)) throw std::invalid_argument("sweep: remission full scale must be > 0");
+  if (!(config_.maxSweepS > config_.tiltWindowS) || !std::isfinite(config_.maxSweepS))
+    throw std::invalid_argument("sweep: max sweep duration must be finite and longer than the tilt window");
+  if (config_.maxSweepPoints == 0) throw std::invalid_argument("sweep: max sweep points must be > 0");
 }
 
 void SweepAssembler::addTilt(const drivers::TiltSample& sample) {
@@ -31,6 +36,7 @@ void SweepAssembler::addTilt(const drivers::TiltSample& sample) {
     return;
   }
   tilt_.push_back(sample);
+  if (!stillFrom_ || std::abs(sample.angle - stillFrom_->angle) >= config_.minTiltChange) stillFrom_ = sample;
   process(false);
 }
 
@@ -85,8 +91,14 @@ void SweepAssembler::process(bool final) {
     reversalRefuted_ = false;  // the next scan and the sweep's last tilt may have changed
   }
   // Keep the tilt history the pending scans (and late ones) can still need.
-  const Stamp keepFrom = (pending_.empty() ? newestScan_ : pending_.front().stamp) - 2 * windowNs_;
+  // While the laser is silent that would be everything: never more than maxSweepS behind the
+  // newest sample.
+  const Stamp keepFrom = std::max((pending_.empty() ? newestScan_ : pending_.front().stamp) - 2 * windowNs_,
+                                  tilt_.empty() ? Stamp{} : tilt_.back().stamp - maxSweepNs_);
   while (tilt_.size() > 2 && tilt_[1].stamp < keepFrom) tilt_.pop_front();
+  stats_.tiltStillS = stillFrom_ && newestScan_ > stillFrom_->stamp
+                          ? static_cast<double>(newestScan_ - stillFrom_->stamp) * 1e-9
+                          : 0.0;
   if (final) {
     closeSweep();
   } else if (config_.closeOnTilt && tiltProvesReversal()) {
@@ -172,6 +184,11 @@ void SweepAssembler::useScan(const drivers::LaserScan& scan, const std::vector<d
   const int dir = std::abs(change) < config_.minTiltChange ? 0 : (change > 0 ? 1 : -1);
   const bool reversal = dir != 0 && direction_ != 0 && dir != direction_;
   if (reversal || pause) closeSweep();
+  // No reversal for too long (tilt parked or stuck, or far too slow): not a nod. Cut, so that
+  // memory stays bounded, and start afresh with this scan.
+  if (hasOpen_ && (lastBeamStamp(scan) - open_.start > maxSweepNs_ ||
+                   open_.points.size() + scan.size() > config_.maxSweepPoints))
+    cutSweep();
   if (dir != 0) direction_ = dir;
   if (!hasOpen_) {
     open_ = Sweep{};
@@ -209,6 +226,12 @@ void SweepAssembler::closeSweep() {
   ++stats_.sweeps;
   stats_.points += open_.points.size();
   done_.push_back(std::move(open_));
+  open_ = Sweep{};
+  hasOpen_ = false;
+}
+
+void SweepAssembler::cutSweep() {
+  ++stats_.sweepsCut;
   open_ = Sweep{};
   hasOpen_ = false;
 }

@@ -48,6 +48,23 @@ TEST(Config, ErrorsNameFileLineAndKey) {
   EXPECT_NE(errorOf("tilt:\n  min_deg: 10\n  max_deg: 5\n").find("min_deg must be below"), std::string::npos);
 }
 
+// Issue 37: a complex key (a sequence or mapping as key) was a yaml-cpp conversion error that
+// nothing caught (SIGHUP and --check-config ended in std::terminate), and `.nan` passed every
+// range check. Both are config errors naming the file, line and key.
+TEST(Config, ComplexKeysAndNonFiniteNumbersAreConfigErrors) {
+  EXPECT_EQ(errorOf("? [a]: 1\n"), "test.yaml:1: a key must be a plain name, not a mapping");
+  EXPECT_EQ(errorOf("[a]: 1\n"), "test.yaml:1: a key must be a plain name, not a sequence");
+  EXPECT_EQ(errorOf("laser:\n  ? {x: 1}\n  : 2\n"), "test.yaml:2: a key must be a plain name, not a mapping (in laser)");
+  EXPECT_EQ(errorOf("detection:\n  classes:\n    ? [car]\n    : {min_neighbors: 2}\n"),
+            "test.yaml:3: a key must be a plain name, not a sequence (in detection.classes)");
+  EXPECT_EQ(errorOf("detection:\n  scale_factor: .nan\n"), "test.yaml:2: key detection.scale_factor: not a finite number");
+  EXPECT_EQ(errorOf("detection:\n  step: .inf\n"), "test.yaml:2: key detection.step: not a finite number");
+  EXPECT_EQ(errorOf("fusion:\n  tilt_axis_offset: [0, .nan, 0.05]\n"),
+            "test.yaml:2: key fusion.tilt_axis_offset: not a finite number");
+  EXPECT_EQ(errorOf("fusion:\n  laser_to_camera:\n    translation: [-.inf, 0, 0]\n"),
+            "test.yaml:3: key fusion.laser_to_camera.translation: not a finite number");
+}
+
 TEST(Config, CameraKeys) {
   const Config c = parseConfig("camera:\n  usb: 046d:0825:ABC\n  format: auto\n  exposure: 8000\n  gain: auto\n  buffers: 6\n",
                                "cam.yaml");

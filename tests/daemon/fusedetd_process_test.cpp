@@ -364,6 +364,22 @@ TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
   EXPECT_FALSE(fs::exists(dir / "b.sock"));
 }
 
+// Issue 37: `--check-config` on a file with a YAML complex key aborted (uncaught
+// YAML::TypedBadConversion, exit 134), and `scale_factor: .nan` passed with exit 0. Both are now
+// config errors: exit 1, the file, line and what is wrong.
+TEST(Fusedetd, CheckConfigRefusesComplexKeysAndNonFiniteNumbers) {
+  const fs::path dir = tempDir("checkconfig");
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"? [a]: 1\n", "bad.yaml:1: a key must be a plain name, not a mapping"},
+      {"detection:\n  scale_factor: .nan\n", "bad.yaml:2: key detection.scale_factor: not a finite number"}};
+  for (const auto& [yaml, message] : cases) {
+    std::ofstream(dir / "bad.yaml") << yaml;
+    Process check({kDaemon, "--config", (dir / "bad.yaml").string(), "--check-config"}, {}, dir / "log");
+    EXPECT_EQ(check.wait(60s), 1) << yaml;
+    EXPECT_NE(readFile(dir / "log").find(message), std::string::npos) << readFile(dir / "log");
+  }
+}
+
 namespace {
 // A cascade far too slow for the machine: 2000 distinct stumps that accept every window, then a
 // stage that rejects it (~3 s of CPU per KITTI-sized stack here): the realistic way a detection

@@ -31,6 +31,33 @@ TEST(BoundedQueue, DropsTheOldestAndCountsIt) {
   EXPECT_EQ(q.pop(std::chrono::milliseconds(50)), std::nullopt);
 }
 
+// Issue 37: the sensor queue was bounded by count only - 512 1080p YUYV frames are 2 GB. With a
+// size function it drops its oldest items also to stay within a byte budget, keeps the newest
+// even alone over it, and a waiting (lossless) producer waits for half the budget.
+TEST(BoundedQueue, ABytesBudgetBoundsItToo) {
+  constexpr std::size_t kFrame = 1920 * 1080 * 2;
+  BoundedQueue<std::vector<std::uint8_t>> q(512, 4 * kFrame, [](const std::vector<std::uint8_t>& v) { return v.size(); });
+  for (int i = 0; i < 10; ++i) q.push(std::vector<std::uint8_t>(kFrame, static_cast<std::uint8_t>(i)));
+  auto c = q.counters();
+  EXPECT_EQ(c.depth, 4u);
+  EXPECT_EQ(c.dropped, 6u);
+  EXPECT_EQ(c.bytes, 4 * kFrame);
+  EXPECT_EQ(q.pop(std::chrono::milliseconds(0))->front(), 6);  // the oldest kept
+  EXPECT_EQ(q.counters().bytes, 3 * kFrame);
+  EXPECT_FALSE(q.waitForRoom(512, std::chrono::milliseconds(0)));  // 3 of 4 frames' budget used
+  q.pop(std::chrono::milliseconds(0));
+  EXPECT_TRUE(q.waitForRoom(512, std::chrono::milliseconds(0)));
+  q.push(std::vector<std::uint8_t>(8 * kFrame));  // alone over the budget: kept, the rest dropped
+  c = q.counters();
+  EXPECT_EQ(c.depth, 1u);
+  EXPECT_EQ(c.bytes, 8 * kFrame);
+  // Small items still count against the capacity.
+  BoundedQueue<std::vector<std::uint8_t>> small(3, 1 << 20, [](const std::vector<std::uint8_t>& v) { return v.size(); });
+  for (int i = 0; i < 5; ++i) small.push(std::vector<std::uint8_t>(10));
+  EXPECT_EQ(small.counters().depth, 3u);
+  EXPECT_EQ(small.counters().bytes, 30u);
+}
+
 TEST(Stats, PercentilesAndRates) {
   std::vector<double> v;
   for (int i = 100; i >= 1; --i) v.push_back(i);

@@ -405,3 +405,31 @@ TEST(ReplayService, LaserLineNoiseShowsAsCrcErrorsInStatusAndTheReplayGoesOn) {
   EXPECT_EQ(replay["state"], "finished");
   EXPECT_GE(lines.size(), 1u) << status.dump();
 }
+
+// Issue 37: an exception from the MCAP reader (here: the log shrank after it was indexed, as when
+// it is replaced or cut while the daemon replays it) escaped the replay thread and ended the
+// process through std::terminate. Now the replay ends as a failed source whose last_error says
+// why; the service keeps serving.
+TEST(ReplayService, ALogThatShrinksUnderTheReplayFailsTheSourceNotTheProcess) {
+  const fs::path log = testlogs::daemonTestLog(kStrokes);
+  const fs::path shrinking = fs::path(tempSocket("x")).parent_path() / "shrinking.mcap";
+  fs::copy_file(log, shrinking, fs::copy_options::overwrite_existing);
+  const Config config = replayConfig(tempSocket("shrink.sock"), shrinking);
+  auto service = startReplay(config);  // the log is indexed here, whole
+  fs::resize_file(shrinking, fs::file_size(log) / 3);
+  service->start();
+  const auto end = std::chrono::steady_clock::now() + 120s;
+  while (!service->finished() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(service->finished());
+  EXPECT_TRUE(service->failed());
+  const nlohmann::json status = service->status();
+  const auto& replay = status["sensors"][0];
+  EXPECT_EQ(replay["state"], "failed") << replay.dump();
+  EXPECT_NE(replay["last_error"].get<std::string>().find("shrank"), std::string::npos) << replay.dump();
+  Client client(config.socket.path);  // still serving
+  client.send({{"cmd", "hello"}});
+  auto hello = client.read(5s);
+  ASSERT_TRUE(hello);
+  EXPECT_EQ((*hello)["type"], "hello");
+  service->stop(std::chrono::steady_clock::now() + 1500ms);
+}

@@ -6,9 +6,12 @@
 
 #include <gtest/gtest.h>
 #include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <thread>
 
@@ -221,4 +224,64 @@ TEST(Server, ClientLimitLatestAndHalfClose) {
   // A live socket path is not stolen by a second server.
   EXPECT_THROW(bindUnixSocket(path), std::system_error);
   server.stop(std::chrono::steady_clock::now() + 1s);
+}
+
+// docs/protocol.md: an error line carries the request's "id" when the request had one (issue 37:
+// it never did). Requests that are not a JSON object have no id to carry.
+TEST(Server, ErrorLinesCarryTheRequestsId) {
+  const std::string path = tempSocket("errid.sock");
+  Server server(bindUnixSocket(path), {}, {});
+  server.start();
+  Client a(path);
+  const std::vector<std::pair<nlohmann::json, std::string>> bad{
+      {{{"cmd", "launch"}, {"id", 3}}, "unknown cmd 'launch'"},
+      {{{"cmd", "status"}, {"classes", {"car"}}, {"id", "q7"}}, "\"classes\" only goes with subscribe"},
+      {{{"id", nlohmann::json{{"seq", 9}}}}, "missing \"cmd\""}};
+  for (const auto& [request, reason] : bad) {
+    a.send(request);
+    auto reply = a.read(5s);
+    ASSERT_TRUE(reply) << request.dump();
+    EXPECT_EQ((*reply)["type"], "error");
+    EXPECT_NE((*reply)["error"].get<std::string>().find(reason), std::string::npos) << reply->dump();
+    EXPECT_EQ((*reply)["id"], request["id"]) << reply->dump();
+  }
+  a.send({{"cmd", "launch"}});
+  auto noId = a.read(5s);
+  ASSERT_TRUE(noId);
+  EXPECT_EQ((*noId)["type"], "error");
+  EXPECT_FALSE(noId->contains("id")) << noId->dump();
+  a.sendLine("[1, 2]");
+  auto notObject = a.read(5s);
+  ASSERT_TRUE(notObject);
+  EXPECT_FALSE(notObject->contains("id")) << notObject->dump();
+  server.stop(std::chrono::steady_clock::now() + 1s);
+}
+
+// A socket file is replaced only when connecting to it is refused (nobody listens: stale). Any
+// other error - here a datagram socket of another program at the path (EPROTOTYPE), as EACCES
+// for a socket its owner keeps from us - leaves the file alone and names the path (issue 37: the
+// check unlinked on every connect error).
+TEST(Server, OnlyARefusedConnectionMakesASocketFileStale) {
+  const std::string path = tempSocket("other.sock");
+  std::filesystem::remove(path);
+  drivers::UniqueFd other(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  ASSERT_EQ(::bind(other.get(), reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0) << std::strerror(errno);
+  try {
+    (void)bindUnixSocket(path);
+    ADD_FAILURE() << "took over another program's socket " << path;
+  } catch (const std::system_error& e) {
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  // Still the other program's: a datagram sent to the path arrives.
+  drivers::UniqueFd sender(::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0));
+  ASSERT_EQ(::sendto(sender.get(), "x", 1, 0, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 1) << std::strerror(errno);
+  char got = 0;
+  EXPECT_EQ(::recv(other.get(), &got, 1, MSG_DONTWAIT), 1);
+  // A stale file (its socket closed, connect refused) is replaced.
+  other.reset();
+  auto fd = bindUnixSocket(path);
+  EXPECT_TRUE(fd.valid());
 }

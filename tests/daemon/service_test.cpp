@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdint>
 #include <fstream>
 #include <set>
@@ -18,6 +19,7 @@
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/kitti_scenes.h"
 #include "fusedet/daemon/service_parts.h"
+#include "fusedet/drivers/canopen/tilt_drive.h"
 #include "replay_logs.h"
 
 using namespace fusedet;
@@ -262,4 +264,58 @@ TEST(Service, AStalledDetectionThreadIsNotAliveAndStacksAreDroppedNotQueued) {
   detector->stall = false;
   ASSERT_TRUE(waitFor([&] { return service.alive(1'000'000'000); }, 10s));
   service.stop(std::chrono::steady_clock::now() + 1500ms);
+}
+
+namespace {
+// A source whose stop() takes as long as the tilt source bringing a motor to rest, and which may
+// report that the motor did not confirm it (TiltSource::stopProblem).
+class SlowStoppingSource : public Source {
+ public:
+  SlowStoppingSource(std::chrono::milliseconds takes, std::string problem) : takes_(takes), problem_(std::move(problem)) {}
+  void start(SensorSink&) override {}
+  void stop() override {
+    if (!stopped_) std::this_thread::sleep_for(takes_);
+    stopped_ = true;
+  }
+  std::vector<SensorHealth> health() const override {
+    SensorHealth h;
+    h.name = "tilt";
+    h.state = stopped_ ? "stopped" : "streaming";
+    return {h};
+  }
+  std::chrono::milliseconds stopTime() const override { return takes_ + 20ms; }
+  std::string stopProblem() const override { return stopped_ ? problem_ : ""; }
+
+ private:
+  std::chrono::milliseconds takes_;
+  std::string problem_;
+  std::atomic<bool> stopped_{false};
+};
+}  // namespace
+
+// Issue 37: SIGTERM gave the whole stop 0.8 s and exited (0) at 1.0 s while the tilt source could
+// still be waiting up to 1 s for the motor to come to rest. The budget now covers the sources'
+// stop times, stays under systemd's 2 s, and a motor not confirmed at rest is reported, not
+// success (fusedetd exits 1 on a non-empty answer from stop()).
+TEST(Service, TheStopBudgetCoversBringingTheMotorToRestAndAnUnconfirmedStopIsReported) {
+  const auto k = loadKittiScenes(kittiRoot(), {"000105"});
+  for (const std::string& problem : {std::string(), std::string("tilt motor: halt not acknowledged")}) {
+    const Config config = testConfig(tempSocket("slowstop.sock"));
+    ServiceParts p = parts(config, k, std::make_unique<SceneSource>(k.scenes, 100ms, 0));
+    // What TiltSource::stopTime() says with the default drive settings.
+    const auto motorStop = drivers::canopen::TiltDriveConfig{}.stopTimeout() + 60ms;
+    p.sources.push_back(std::make_unique<SlowStoppingSource>(motorStop, problem));
+    Service service(std::move(p));
+    service.start();
+    const auto budget = service.stopBudget();
+    EXPECT_GE(budget, motorStop + 20ms);
+    EXPECT_LE(budget, 1500ms);  // + fusedetd's 200 ms slack: exit under 2 s
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string got = service.stop(t0 + budget);
+    const auto took = std::chrono::steady_clock::now() - t0;
+    EXPECT_TRUE(service.sourcesStopped());
+    EXPECT_EQ(got, problem);
+    EXPECT_GE(took, motorStop);
+    EXPECT_LE(took, budget + 200ms);
+  }
 }

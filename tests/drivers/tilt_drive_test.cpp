@@ -285,3 +285,32 @@ TEST(TiltDrive, StartAgainRestartsFromScratch) {
   const auto sweeps = rig.drive.counters().sweeps;
   EXPECT_TRUE(rig.sweepsDone(sweeps + 1, 30s));
 }
+
+// Issue 37: stopped() also comes when the stop's SDOs time out, and the daemon reported a clean
+// stop either way. stopConfirmed() tells the two apart: only a node that acknowledged the halt
+// and the shutdown is known to be at rest.
+TEST(TiltDrive, AStopTheNodeNeverAcknowledgesIsNotConfirmed) {
+  {
+    Rig rig;
+    ASSERT_TRUE(rig.startUp());
+    ASSERT_TRUE(rig.net.runUntil([&] { return rig.samples.size() >= 20; }, 5s));
+    rig.drive.stop();
+    ASSERT_TRUE(rig.net.runUntil([&] { return rig.drive.stopped(); }, 2s));
+    EXPECT_TRUE(rig.drive.stopConfirmed());
+  }
+  Rig rig;
+  ASSERT_TRUE(rig.startUp());
+  ASSERT_TRUE(rig.net.runUntil([&] { return rig.samples.size() >= 20; }, 5s));
+  rig.motor.silence(10s);  // cut off the bus: it hears nothing and answers nothing
+  rig.drive.stop();
+  EXPECT_FALSE(rig.drive.stopped());
+  // Ends by the stop timeout all the same (the daemon's stop budget counts on that) ...
+  ASSERT_TRUE(rig.net.runUntil([&] { return rig.drive.stopped(); }, rig.config.stopTimeout() + 20ms));
+  // ... but not as a confirmed stop.
+  EXPECT_FALSE(rig.drive.stopConfirmed());
+  // A drive never started has nothing to bring to rest.
+  Rig idle;
+  idle.drive.stop();
+  EXPECT_TRUE(idle.drive.stopped());
+  EXPECT_TRUE(idle.drive.stopConfirmed());
+}

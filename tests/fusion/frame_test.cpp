@@ -122,6 +122,36 @@ TEST(FramePairer, PicksTheFrameNearestTheSweepMiddleWithinTheSkew) {
   EXPECT_EQ(pairer.framesDropped(), 5u);
 }
 
+// Issue 37: 32 buffered 1080p frames are 200 MB; the pairer also keeps its frames' bytes under
+// a budget (the newest frame always stays), and bytes leave with paired frames.
+TEST(FramePairer, KeepsItsFramesUnderAByteBudget) {
+  constexpr std::size_t kFrame = 1920 * 1080 * 2;
+  FramePairer pairer(50'000'000, 32, 3 * kFrame);
+  for (int i = 0; i < 10; ++i) {
+    CameraFrame f;
+    f.sequence = static_cast<std::uint64_t>(i);
+    f.stamp = Stamp{1'000'000'000 + i * 66'000'000};
+    f.bytes.assign(kFrame, 0);
+    pairer.addFrame(std::move(f));
+  }
+  EXPECT_EQ(pairer.buffered(), 3u);
+  EXPECT_EQ(pairer.bufferedBytes(), 3 * kFrame);
+  EXPECT_EQ(pairer.framesDropped(), 7u);
+  fusion::Sweep s;
+  s.start = Stamp{1'400'000'000};
+  s.end = Stamp{1'600'000'000};  // middle 1.5 s: frame 8 (1.528 s)
+  const auto f = pairer.pair(s);
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->sequence, 8u);
+  EXPECT_EQ(pairer.buffered(), 1u);
+  EXPECT_EQ(pairer.bufferedBytes(), kFrame);
+  CameraFrame huge;
+  huge.bytes.assign(4 * kFrame, 0);
+  pairer.addFrame(std::move(huge));
+  EXPECT_EQ(pairer.buffered(), 1u);
+  EXPECT_EQ(pairer.bufferedBytes(), 4 * kFrame);
+}
+
 TEST(CameraLayers, HueMatchesOpenCvFloatHsv) {
   cv::Mat bgr(60, 80, CV_8UC3);
   cv::randu(bgr, 0, 256);

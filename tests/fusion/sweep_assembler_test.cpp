@@ -423,3 +423,66 @@ TEST(SweepAssemblerClose, WithoutTiltSamplesAfterTheSweepItClosesAsBefore) {
     EXPECT_EQ(stats.sweepsClosedOnTilt, 0u);
   }
 }
+
+// Issue 37: a parked (or faulted) tilt motor while the laser scans. Every scan is at rest, so it
+// joined the open sweep, which never closed: its points grew without bound (a minute here is
+// 900k points; hours on a robot). Now no sweep - emitted or open - spans more than maxSweepS,
+// the over-long ones are cut and counted, and tiltStillS says how long the tilt has stood still.
+TEST(SweepAssemblerBounds, AParkedTiltNeverGrowsASweepPastItsLimit) {
+  SweepConfig config = wallConfig();
+  config.maxSweepS = 4.0;
+  SweepAssembler a(config);
+  const auto parkedAfterOneNod = [](std::int64_t ns) { return triangle(std::min<std::int64_t>(ns, kT0 + 2'000'000'000)); };
+  const std::int64_t end = kT0 + 60'000'000'000;  // a minute of scans at 75 Hz
+  std::size_t maxOpen = 0;
+  std::int64_t nextTilt = kT0 - 20'000'000, nextScan = kT0;
+  std::uint64_t seq = 0;
+  std::vector<Sweep> sweeps;
+  while (nextScan < end) {
+    if (nextTilt <= nextScan) {
+      a.addTilt(TiltSample{Stamp{nextTilt}, parkedAfterOneNod(nextTilt), 0});
+      nextTilt += 10'000'000;
+    } else {
+      a.addScan(wallScan(nextScan, parkedAfterOneNod, seq++));
+      nextScan += kScanNs;
+    }
+    maxOpen = std::max(maxOpen, a.openPoints());
+    for (Sweep& s : a.takeSweeps()) sweeps.push_back(std::move(s));
+  }
+  const SweepStats stats = a.stats();
+  a.flush();
+  for (Sweep& s : a.takeSweeps()) sweeps.push_back(std::move(s));
+  ASSERT_FALSE(sweeps.empty());
+  for (const Sweep& s : sweeps) EXPECT_LE((s.end - s.start) * 1e-9, config.maxSweepS + 0.02) << "sweep " << s.id;
+  // 4 s of scans: 300 scans of 201 points.
+  EXPECT_LE(maxOpen, static_cast<std::size_t>(config.maxSweepS * 75 + 2) * 201);
+  // Parked from 2 s on: (60 - 2 - the first cut's partial) / 4 s cuts.
+  EXPECT_GE(stats.sweepsCut, 13u);
+  EXPECT_LE(stats.sweepsCut, 15u);
+  EXPECT_NEAR(stats.tiltStillS, 58.0, 0.1);
+}
+
+TEST(SweepAssemblerBounds, TheOpenSweepIsCutAtMaxSweepPoints) {
+  SweepConfig config = wallConfig();
+  config.maxSweepPoints = 201 * 10;
+  SweepAssembler a(config);
+  feed(a, kT0 + 1'000'000'000, [](std::int64_t) { return 0.1; });
+  // 75 scans at rest: cut after every 10 scans.
+  EXPECT_EQ(a.stats().sweepsCut, 7u);
+  EXPECT_LE(a.openPoints(), config.maxSweepPoints);
+}
+
+// The tilt history was trimmed only relative to the newest scan: with the laser silent it grew
+// with every sample. Now samples older than maxSweepS before the newest one are forgotten.
+TEST(SweepAssemblerBounds, ASilentLaserDoesNotGrowTheTiltHistory) {
+  SweepConfig config = wallConfig();
+  config.maxSweepS = 2.0;
+  SweepAssembler a(config);
+  for (std::int64_t t = kT0; t < kT0 + 600'000'000'000; t += 10'000'000)  // 10 min at 100 Hz
+    a.addTilt(TiltSample{Stamp{t}, triangle(kT0 + (t - kT0) % 2'000'000'000), 0});
+  EXPECT_LE(a.tiltSamplesKept(), 202u);
+  double angle = 0;
+  EXPECT_FALSE(a.tiltAt(Stamp{kT0 + 1'000'000'000}, angle));           // long forgotten
+  EXPECT_TRUE(a.tiltAt(Stamp{kT0 + 600'000'000'000 - 500'000'000}, angle));  // recent: kept
+  EXPECT_EQ(a.stats().tiltSamples, 60'000u);
+}

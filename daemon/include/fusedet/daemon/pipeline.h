@@ -2,7 +2,7 @@
 // Pipeline: sensor messages -> sweep assembly -> pairing -> fusion (fusion thread) -> every class
 // (detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
 // own threads and push into the sensor queue through the SensorSink interface; both queues are
-// bounded and drop their oldest item when full (counted), so no producer ever waits. When
+// bounded (the sensor queue by count and bytes) and drop their oldest item when full (counted), so no producer ever waits. When
 // detection falls behind, the stack queue (2 deep) drops the oldest stack. Lossless mode (a log
 // replayed as fast as possible) is the exception: there the source waits for room (awaitRoom)
 // and fusion for detection, so every stack is detected and a replay is deterministic.
@@ -67,6 +67,8 @@ struct PipelineSetup {
   fusion::SweepConfig sweep;
   std::int64_t maxPairSkewNs = 150'000'000;
   std::size_t sensorQueueCapacity = 512;  // messages between sources and fusion
+  std::size_t sensorQueueBytes = 64u << 20;  // and their bytes: ~16 1080p YUYV frames (512 would be 2 GB)
+  std::size_t pairerBytes = 64u << 20;      // camera frames waiting for their sweep (fusion::FramePairer)
   std::size_t stackQueueCapacity = 2;     // fused stacks waiting for detection
   // Fusion waits for room in the stack queue instead of dropping the oldest stack. Only for
   // sources that can wait too (a log replayed as fast as possible), never for live devices.
@@ -132,6 +134,7 @@ class Pipeline : public SensorSink {
   struct EndOfStream {};
   using SensorMessage =
       std::variant<drivers::LaserScan, drivers::TiltSample, drivers::CameraFrame, PairedScene, EndOfStream>;
+  static std::size_t bytesOf(const SensorMessage& message);
   struct FusedStack {
     LayerStack stack;
     Stamp sweepStart, sweepEnd, frameStamp;

@@ -23,8 +23,9 @@ struct Request {
 };
 
 // Parses one request line (without its newline). On failure returns nothing and sets `error` to
-// a short reason ("not JSON: ...", "missing \"cmd\"", "unknown cmd 'x'", ...).
-std::optional<Request> parseRequest(std::string_view line, std::string& error);
+// a short reason ("not JSON: ...", "missing \"cmd\"", "unknown cmd 'x'", ...) and `id` (when
+// given) to the request's "id" if it was a JSON object with one, so the error line carries it.
+std::optional<Request> parseRequest(std::string_view line, std::string& error, nlohmann::json* id = nullptr);
 
 // {"type":"detections", ...} for one stack; only the detections of `classes` (empty = all).
 nlohmann::json resultToJson(const StackResult& result, const std::set<std::string>& classes = {},

@@ -37,6 +37,7 @@ class ReplaySource : public Source {
   void stop() override;
   std::vector<SensorHealth> health() const override;
   bool finished() const override { return finished_.load(); }
+  bool failed() const override { return failed_.load(); }
   // What is wrong with the log ("" when intact).
   const std::string& damage() const { return damage_; }
   // Messages of the log's intact part (what progress counts against).
@@ -44,6 +45,7 @@ class ReplaySource : public Source {
 
  private:
   void run(SensorSink& sink);
+  void replay(SensorSink& sink);
   void record(const drivers::logs::SensorReplayCounters& counters);
 
   ReplaySettings settings_;
@@ -52,14 +54,14 @@ class ReplaySource : public Source {
   std::uint64_t logMessages_ = 0;                        // messages in the intact part of the log
   std::string damage_;
   std::thread thread_;
-  std::atomic<bool> stop_{false}, finished_{false};
+  std::atomic<bool> stop_{false}, finished_{false}, failed_{false};
 
   mutable std::mutex mutex_;  // guards the counters below
   drivers::logs::SensorReplayCounters pass_;  // this pass
   std::uint64_t delivered_ = 0;               // scans, tilt samples and frames handed on, all passes
   std::uint64_t crcErrors_ = 0, lost_ = 0;    // all finished passes (plus pass_)
   std::uint64_t passes_ = 0;
-  std::string error_;  // the log could not be reopened for another pass
+  std::string error_;  // why the replay failed (the reader threw: I/O error, file changed)
 };
 
 }  // namespace fusedet::daemon

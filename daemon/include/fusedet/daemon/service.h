@@ -3,6 +3,7 @@
 // answers to `hello` and `status`, reload (SIGHUP) and the liveness the systemd watchdog is fed
 // from. run.h drives it from signals and sd_notify.
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -57,8 +58,16 @@ class Service {
 
   // Starts the server, the pipeline threads and the sources: afterwards requests are served.
   void start();
-  // Stops the sources, drains the pipeline and flushes clients, all by `deadline`.
-  void stop(std::chrono::steady_clock::time_point deadline);
+  // Stops the sources (each takes up to its Source::stopTime(): a tilt motor is brought to rest
+  // first), drains the pipeline and flushes clients, all by `deadline` when that is at least
+  // stopBudget() away. Returns "" when every source stopped safely, else what did not (a motor
+  // not confirmed at rest): the caller must not report success then.
+  std::string stop(std::chrono::steady_clock::time_point deadline);
+  // What a SIGTERM stop needs: the sources' stop times plus a drain, at least kDrainBudget.
+  std::chrono::milliseconds stopBudget() const;
+  static constexpr std::chrono::milliseconds kDrainBudget{800};
+  // True once stop() has stopped every source (the pipeline and clients may still drain).
+  bool sourcesStopped() const { return sourcesStopped_.load(); }
 
   // Re-reads the config file and the models. Returns "" when applied; else why the old
   // configuration is kept. Detection settings, models, socket limits and the log level take
@@ -79,6 +88,9 @@ class Service {
   // Every source is finite and has delivered everything, and the pipeline is idle: all results
   // have reached the server (a replayed log at its end).
   bool finished() const;
+  // Some source ended on an error it could not recover from (a replayed log that failed under
+  // the reader): the end of a replay is then no success (fusedetd exits 1).
+  bool failed() const;
 
   Pipeline& pipeline() { return *pipeline_; }
   Server& server() { return *server_; }
@@ -97,6 +109,7 @@ class Service {
   std::unique_ptr<Pipeline> pipeline_;
   std::int64_t startedNs_ = 0;
   bool started_ = false;
+  std::atomic<bool> sourcesStopped_{false};
 };
 
 }  // namespace fusedet::daemon

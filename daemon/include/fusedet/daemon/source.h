@@ -5,6 +5,7 @@
 // reports its health for the `status` request.
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -63,6 +64,14 @@ class Source {
   virtual std::vector<SensorHealth> health() const = 0;
   // A finite source (a replayed log, recorded scenes) that has delivered everything it will.
   virtual bool finished() const { return false; }
+  // Finished because of an error it could not recover from (health().lastError says which).
+  virtual bool failed() const { return false; }
+  // The longest stop() can take (a tilt motor is brought to rest first): the daemon's stop
+  // budget covers the sum over its sources.
+  virtual std::chrono::milliseconds stopTime() const { return std::chrono::milliseconds(0); }
+  // After stop(): "" when the source stopped safely, else what is not safe (a motor that did not
+  // confirm it is at rest). fusedetd then exits 1.
+  virtual std::string stopProblem() const { return {}; }
 };
 
 }  // namespace fusedet::daemon

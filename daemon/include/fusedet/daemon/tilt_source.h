@@ -24,6 +24,9 @@ class TiltSource : public Source {
   void start(SensorSink& sink) override;
   void stop() override;
   std::vector<SensorHealth> health() const override;
+  // stop() brings the motor to rest first: at most the drive's stop timeout plus thread joins.
+  std::chrono::milliseconds stopTime() const override;
+  std::string stopProblem() const override;
 
  private:
   void run(SensorSink& sink);
@@ -35,6 +38,7 @@ class TiltSource : public Source {
   mutable std::mutex mutex_;
   std::condition_variable wake_;
   std::string state_ = "stopped", lastError_;
+  std::string stopProblem_;  // the last stop() could not confirm the motor at rest
   std::uint64_t reconnects_ = 0, opens_ = 0;
   drivers::canopen::TiltDriveCounters counters_;
 };

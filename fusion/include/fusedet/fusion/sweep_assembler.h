@@ -26,6 +26,14 @@
 // stream late, missing or at rest, direction unknown, scans out of order) the sweep closes as
 // without `closeOnTilt`: when the first scan against the direction is in. The assignment of
 // scans to sweeps is the same either way.
+//
+// Bounds (a parked or faulted tilt motor while the laser scans): a scan at rest joins the open
+// sweep, so without a reversal it would never close. An open sweep that would span more than
+// `maxSweepS` or hold more than `maxSweepPoints` points is cut: dropped (not a nod: fusing it would
+// give a stack of one laser line) and counted in `sweepsCut`; the scan starts the next sweep.
+// Tilt samples older than `maxSweepS` before the newest one are forgotten even while the laser is
+// silent (scans that late are dropped as having no tilt). `tiltStillS` says for how long the laser
+// has scanned while the tilt stood still (the daemon's `status` shows it).
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -49,6 +57,8 @@ struct SweepConfig {
   double maxScanGapS = 1.0;          // a longer pause between scans closes the sweep
   double minTiltChange = 1e-5;       // [rad] over one scan; below it the direction is undecided
   bool closeOnTilt = true;           // close when the tilt proves the reversal (false: when the next scan shows it)
+  double maxSweepS = 10.0;           // a longer open sweep is cut and dropped; also the tilt history kept
+  std::size_t maxSweepPoints = 1'000'000;  // a sweep with more points is cut and dropped (24 MB)
 };
 
 struct SweepStats {
@@ -60,6 +70,8 @@ struct SweepStats {
   std::uint64_t sweeps = 0;            // sweeps completed
   std::uint64_t sweepsClosedOnTilt = 0;  // of these, closed by tilt samples before the next scan (closeOnTilt)
   std::uint64_t points = 0;            // points in completed sweeps
+  std::uint64_t sweepsCut = 0;         // open sweeps over maxSweepS / maxSweepPoints, dropped
+  double tiltStillS = 0;               // newest scan - when the tilt last moved (~a sample period while it moves)
 };
 
 class SweepAssembler {
@@ -80,15 +92,21 @@ class SweepAssembler {
   // Tilt angle at time t interpolated from the samples around it, or false if there are none
   // within the window on both sides. Exposed for tests and diagnostics.
   bool tiltAt(Stamp t, double& angle) const;
+  // Tilt samples kept (bounded by maxSweepS of history) and points in the open sweep.
+  std::size_t tiltSamplesKept() const { return tilt_.size(); }
+  std::size_t openPoints() const { return hasOpen_ ? open_.points.size() : 0; }
 
  private:
   void process(bool final);
   void useScan(const drivers::LaserScan& scan, const std::vector<double>& tilt);
   void closeSweep();
+  void cutSweep();
   bool tiltProvesReversal();
 
   SweepConfig config_;
   std::int64_t windowNs_;
+  std::int64_t maxSweepNs_;
+  std::optional<drivers::TiltSample> stillFrom_;  // the sample the tilt has not moved away from since
   std::deque<drivers::TiltSample> tilt_;
   std::deque<drivers::LaserScan> pending_;
   Stamp newestScan_{};             // last beam of the newest scan received

@@ -46,6 +46,8 @@ struct TiltDriveConfig {
   std::chrono::milliseconds retryMin{100}, retryMax{2000};
 
   std::string validate() const;  // empty if usable
+  // stop() ends by then, acknowledged or not (halt + shutdown, each an SDO of sdoTimeout).
+  std::chrono::milliseconds stopTimeout() const { return sdoTimeout * 3; }
 };
 
 enum class TiltPhase { kIdle, kBooting, kConfiguring, kEnabling, kRunning, kFault, kStopping, kStopped };
@@ -98,8 +100,12 @@ class TiltDrive : public CanNode {
   void start();
   void nod();
   void hold(double angleRad);
-  // Halt, shutdown (drive disabled), NMT pre-operational, SYNC off; stopped() once done.
+  // Halt, shutdown (drive disabled), NMT pre-operational, SYNC off; stopped() once done, at the
+  // latest after config().stopTimeout(). stopConfirmed(): the node acknowledged both the halt
+  // and the shutdown (or the drive was never started) - false when stopped() came by timeout, so
+  // the motor may still be moving.
   void stop();
+  bool stopConfirmed() const;
 
   void onFrame(const CanFrame& f) override;
   void poll(Stamp now) override;
@@ -143,6 +149,7 @@ class TiltDrive : public CanNode {
   TiltDriveCounters counters_;
 
   TiltPhase phase_ = TiltPhase::kIdle;
+  bool haltAcked_ = false, stopConfirmed_ = false;
   bool startRequested_ = false;
   std::uint64_t generation_ = 0;   // bumped on every fault: stale SDO callbacks are ignored
   Stamp now_{};
