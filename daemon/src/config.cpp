@@ -158,6 +158,11 @@ Config parseTree(const YAML::Node& root, const std::string& source) {
     s.readRange("max_request_bytes", c.socket.maxRequestBytes, 64, 1 << 20);
     s.readRange("client_queue", c.socket.clientQueue, 1, 1 << 16);
     s.readRange("client_send_buffer", c.socket.clientSendBuffer, 0, 1 << 24);
+    s.read("mode", c.socket.mode);
+    if (!parseSocketMode(c.socket.mode))
+      s.fail(s.at("mode"), "key socket.mode: '" + c.socket.mode + "' is not an octal mode from 0000 to 0777");
+    s.read("group", c.socket.group);
+    s.read("allow_groups", c.socket.allowGroups);
     s.finish();
   }
   {
@@ -286,6 +291,13 @@ Config loadConfig(const std::filesystem::path& file) {
   return parseConfig(text.str(), file.string());
 }
 
+std::optional<unsigned> parseSocketMode(const std::string& text) {
+  if (text.empty() || text.size() > 4 || text.find_first_not_of("01234567") != std::string::npos) return std::nullopt;
+  const auto mode = static_cast<unsigned>(std::stoul(text, nullptr, 8));
+  if (mode > 0777u) return std::nullopt;
+  return mode;
+}
+
 std::filesystem::path installedConfigFile(const std::filesystem::path& executable) {
   const std::filesystem::path prefix = executable.parent_path().parent_path();
   const std::filesystem::path etc = prefix == "/usr" ? std::filesystem::path("/etc") : prefix / "etc";
@@ -308,7 +320,12 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients;
   out << YAML::Key << "max_request_bytes" << YAML::Value << c.socket.maxRequestBytes;
   out << YAML::Key << "client_queue" << YAML::Value << c.socket.clientQueue;
-  out << YAML::Key << "client_send_buffer" << YAML::Value << c.socket.clientSendBuffer << YAML::EndMap;
+  out << YAML::Key << "client_send_buffer" << YAML::Value << c.socket.clientSendBuffer;
+  out << YAML::Key << "mode" << YAML::Value << YAML::DoubleQuoted << c.socket.mode;
+  out << YAML::Key << "group" << YAML::Value << YAML::DoubleQuoted << c.socket.group;
+  out << YAML::Key << "allow_groups" << YAML::Value;
+  seq(c.socket.allowGroups);
+  out << YAML::EndMap;
   out << YAML::Key << "laser" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "device" << YAML::Value << c.laser.device;
   out << YAML::Key << "baud" << YAML::Value << c.laser.baud;

@@ -63,17 +63,18 @@ int stopWithin(Service& service) {
 }
 
 // The socket systemd passed (socket activation), or one bound at `path`.
-drivers::UniqueFd listenerFor(const std::string& path) {
+drivers::UniqueFd listenerFor(const std::string& path, const SocketAccess& access) {
   const int n = sd_listen_fds(1);
   if (n < 0) throw std::runtime_error(std::string("sd_listen_fds: ") + strerror(-n));
   if (n > 1) throw std::runtime_error("socket activation passed " + std::to_string(n) + " sockets; expected 1");
   if (n == 1) {
     if (sd_is_socket_unix(SD_LISTEN_FDS_START, SOCK_STREAM, 1, nullptr, 0) <= 0)
       throw std::runtime_error("socket activation: the passed fd is not a listening Unix stream socket");
+    checkPassedSocket(SD_LISTEN_FDS_START, access);
     spdlog::info("serving on the socket systemd passed");
     return drivers::UniqueFd(SD_LISTEN_FDS_START);
   }
-  auto fd = bindUnixSocket(path);
+  auto fd = bindUnixSocket(path, access);
   spdlog::info("serving on {}", path);
   return fd;
 }
@@ -108,9 +109,11 @@ int runDaemon(const RunOptions& options) {
     if (!options.socketPath.empty()) config.socket.path = options.socketPath;
     spdlog::set_level(spdlog::level::from_str(config.logLevel));
     const std::string socketPath = config.socket.path;
+    const SocketAccess access = socketAccessFrom(config);
+    (void)serverLimitsFrom(config);  // its groups exist: checked before anything is bound
     exitAtEnd = !config.replay.file.empty() && config.replay.atEnd == "exit";
     ServiceParts parts = serviceParts(std::move(config), options.configFile);
-    parts.listener = listenerFor(socketPath);  // last: nothing is bound when the set-up fails
+    parts.listener = listenerFor(socketPath, access);  // last: nothing is bound when the set-up fails
     service = std::make_unique<Service>(std::move(parts));
     service->start();
   } catch (const std::exception& e) {

@@ -10,10 +10,15 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstddef>
+#include <cstdio>
 #include <cstring>
 #include <deque>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <system_error>
 
 #include "fusedet/daemon/protocol.h"
@@ -41,6 +46,7 @@ void setNonBlocking(int fd) {
 struct Server::Client {
   std::uint64_t key = 0;
   drivers::UniqueFd fd;
+  ucred peer{0, 0, 0};
   std::string in;
   bool discarding = false;  // skipping the rest of an oversized request line
   bool readClosed = false;  // the client shut down its sending side
@@ -52,15 +58,88 @@ struct Server::Client {
   std::set<std::string> classes;
 };
 
-drivers::UniqueFd bindUnixSocket(const std::string& path) {
+namespace {
+
+std::string octal(unsigned mode) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%04o", mode & 07777u);
+  return buf;
+}
+
+// A socket in a directory that others may write to can be removed, replaced or pre-created by
+// them (the sticky bit stops the first two, not the last): only its owner is safe there.
+void checkSocketDirectory(const std::string& path) {
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  struct stat st{};
+  if (::stat(dir.c_str(), &st) < 0) throwErrno("socket directory " + dir.string());
+  if ((st.st_mode & S_IWOTH) && st.st_uid != ::geteuid())
+    throw std::system_error(std::make_error_code(std::errc::permission_denied),
+                            "socket path " + path + ": its directory " + dir.string() + " is world-writable (mode " +
+                                octal(st.st_mode) + ") and owned by uid " + std::to_string(st.st_uid) +
+                                ", not by fusedetd's uid " + std::to_string(::geteuid()) +
+                                ": another local user could replace or pre-create the socket there; use a directory "
+                                "only fusedetd's user can write to (e.g. /run/fusedet)");
+}
+
+// The peer's groups: its primary gid and its supplementary groups (from /proc; none if it is gone).
+std::vector<unsigned> peerGroups(const ucred& peer) {
+  std::vector<unsigned> out{peer.gid};
+  std::ifstream status("/proc/" + std::to_string(peer.pid) + "/status");
+  std::string line;
+  while (std::getline(status, line))
+    if (line.rfind("Groups:", 0) == 0) {
+      std::istringstream in(line.substr(7));
+      unsigned g = 0;
+      while (in >> g) out.push_back(g);
+    }
+  return out;
+}
+
+bool allowed(const ucred& peer, const ServerLimits& limits) {
+  if (limits.allowGroups.empty() || peer.uid == 0 || peer.uid == ::geteuid()) return true;
+  for (const unsigned g : peerGroups(peer))
+    for (const auto& [name, gid] : limits.allowGroups)
+      if (g == gid) return true;
+  return false;
+}
+
+}  // namespace
+
+void checkPassedSocket(int fd, const SocketAccess& access) {
+  sockaddr_un addr{};
+  socklen_t len = sizeof addr;
+  if (::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len) < 0) throwErrno("getsockname of the passed socket");
+  if (len <= offsetof(sockaddr_un, sun_path) || addr.sun_path[0] == '\0') return;  // abstract or unnamed: no file
+  const std::string path(addr.sun_path);
+  struct stat st{};
+  if (::stat(path.c_str(), &st) < 0) throwErrno("passed socket " + path);
+  // Connecting needs write permission on the socket file; the other bits mean nothing for it.
+  const unsigned mode = st.st_mode & 0777u;
+  if ((mode & 0222u) & ~(access.mode & 0222u))
+    throw std::runtime_error("passed socket " + path + " has mode " + octal(mode) + ": it lets more users connect than socket.mode " +
+                             octal(access.mode) + " (SocketMode= in fusedetd.socket)");
+  if (access.group && st.st_gid != *access.group)
+    throw std::runtime_error("passed socket " + path + " belongs to gid " + std::to_string(st.st_gid) + ", not socket.group's " +
+                             std::to_string(*access.group) + " (SocketGroup= in fusedetd.socket)");
+}
+
+drivers::UniqueFd bindUnixSocket(const std::string& path, const SocketAccess& access) {
   sockaddr_un addr{};
   addr.sun_family = AF_UNIX;
   if (path.empty() || path.size() >= sizeof addr.sun_path)
     throw std::system_error(std::make_error_code(std::errc::filename_too_long), "socket path '" + path + "'");
   std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  checkSocketDirectory(path);
   drivers::UniqueFd fd(::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0));
   if (!fd.valid()) throwErrno("socket");
   auto* sa = reinterpret_cast<sockaddr*>(&addr);
+  // Created owner-only, so no one can connect before mode and group are set below.
+  const mode_t umaskBefore = ::umask(0177);
+  struct RestoreUmask {
+    mode_t m;
+    ~RestoreUmask() { ::umask(m); }
+  } restore{umaskBefore};
   if (::bind(fd.get(), sa, sizeof addr) < 0) {
     if (errno != EADDRINUSE) throwErrno("bind " + path);
     // A file exists: replace it only if it is a stale socket - connecting is refused (nobody
@@ -76,7 +155,9 @@ drivers::UniqueFd bindUnixSocket(const std::string& path) {
     if (::unlink(path.c_str()) < 0) throwErrno("removing the stale socket " + path);
     if (::bind(fd.get(), sa, sizeof addr) < 0) throwErrno("bind " + path);
   }
-  if (::chmod(path.c_str(), 0660) < 0) throwErrno("chmod 0660 " + path);
+  if (access.group && ::chown(path.c_str(), static_cast<uid_t>(-1), *access.group) < 0)
+    throwErrno("socket.group: chown " + path + " to gid " + std::to_string(*access.group));
+  if (::chmod(path.c_str(), access.mode) < 0) throwErrno("socket.mode: chmod " + octal(access.mode) + " " + path);
   if (::listen(fd.get(), 64) < 0) throwErrno("listen " + path);
   return fd;
 }
@@ -163,7 +244,9 @@ void Server::run() {
     }
     dispatch();
     // Clients are destroyed only here, so no event of this batch can point at a reused fd.
+    const std::size_t before = clients_.size();
     std::erase_if(clients_, [](const std::unique_ptr<Client>& c) { return c->dead; });
+    if (clients_.size() != before) updatePeers();
     std::lock_guard lock(mutex_);
     counters_.clients = clients_.size();
   }
@@ -182,6 +265,7 @@ void Server::run() {
   clients_.clear();
   std::lock_guard lock(mutex_);
   counters_.clients = 0;
+  peers_.clear();
 }
 
 void Server::accept() {
@@ -204,12 +288,33 @@ void Server::accept() {
       ++counters_.refused;
       continue;
     }
+    ucred peer{0, 0, 0};
+    socklen_t credLen = sizeof peer;
+    if (::getsockopt(fd.get(), SOL_SOCKET, SO_PEERCRED, &peer, &credLen) < 0) {
+      spdlog::warn("server: SO_PEERCRED: {}; connection closed", std::strerror(errno));
+      continue;
+    }
+    if (!allowed(peer, limits)) {
+      std::string groups;
+      for (const auto& [name, gid] : limits.allowGroups) groups += (groups.empty() ? "" : ", ") + name;
+      const std::string why = "not allowed: uid " + std::to_string(peer.uid) + " (pid " + std::to_string(peer.pid) +
+                              ") is in none of socket.allow_groups (" + groups + ")";
+      spdlog::warn("server: refused a client: {}", why);
+      {
+        std::lock_guard lock(mutex_);
+        ++counters_.refusedNotAllowed;  // counted before the client can read why
+      }
+      const std::string line = errorLine(why);
+      [[maybe_unused]] auto w = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+      continue;
+    }
     if (limits.clientSendBuffer > 0 &&
         ::setsockopt(fd.get(), SOL_SOCKET, SO_SNDBUF, &limits.clientSendBuffer, sizeof limits.clientSendBuffer) < 0)
       spdlog::warn("server: SO_SNDBUF {}: {}", limits.clientSendBuffer, std::strerror(errno));
     auto c = std::make_unique<Client>();
     c->key = nextKey_++;
     c->fd = std::move(fd);
+    c->peer = peer;
     epoll_event ev{};
     ev.events = EPOLLIN | EPOLLRDHUP;
     ev.data.u64 = c->key;
@@ -217,11 +322,28 @@ void Server::accept() {
       spdlog::warn("server: epoll_ctl client: {}", std::strerror(errno));
       continue;
     }
+    spdlog::info("server: client {} connected: pid {} uid {} gid {}", c->key, peer.pid, peer.uid, peer.gid);
     clients_.push_back(std::move(c));
-    std::lock_guard lock(mutex_);
-    ++counters_.accepted;
-    counters_.clients = clients_.size();
+    {
+      std::lock_guard lock(mutex_);
+      ++counters_.accepted;
+      counters_.clients = clients_.size();
+    }
+    updatePeers();
   }
+}
+
+void Server::updatePeers() {
+  std::vector<Peer> now;
+  for (const auto& c : clients_)
+    if (!c->dead) now.push_back({c->key, c->peer.pid, c->peer.uid, c->peer.gid, c->subscribed});
+  std::lock_guard lock(mutex_);
+  peers_ = std::move(now);
+}
+
+std::vector<Peer> Server::peers() const {
+  std::lock_guard lock(mutex_);
+  return peers_;
 }
 
 void Server::readFrom(Client& c) {
@@ -307,10 +429,12 @@ void Server::handleLine(Client& c, std::string_view line) {
     case Request::Command::kSubscribe:
       c.subscribed = true;
       c.classes = request->classes;
+      updatePeers();
       reply = {{"type", "subscribed"}, {"classes", c.classes}};
       break;
     case Request::Command::kUnsubscribe:
       c.subscribed = false;
+      updatePeers();
       reply = {{"type", "unsubscribed"}};
       break;
     case Request::Command::kLatest: {
@@ -388,6 +512,7 @@ void Server::updateInterest(Client& c) {
 void Server::drop(Client& c, bool slow) {
   if (c.dead) return;
   c.dead = true;
+  spdlog::debug("server: client {} (pid {}) {}", c.key, c.peer.pid, slow ? "dropped: does not keep up" : "disconnected");
   ::epoll_ctl(epoll_.get(), EPOLL_CTL_DEL, c.fd.get(), nullptr);
   c.fd.reset();
   c.out.clear();

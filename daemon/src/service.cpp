@@ -1,7 +1,9 @@
 #include "fusedet/daemon/service.h"
 
+#include <grp.h>
 #include <spdlog/spdlog.h>
 
+#include <cstring>
 #include <sstream>
 
 #include "fusedet/daemon/protocol.h"
@@ -36,8 +38,29 @@ std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusio
       camera, laserToCamera(config), projection);
 }
 
+namespace {
+unsigned groupId(const std::string& name, const char* key) {
+  std::vector<char> buf(16384);
+  struct group g{};
+  struct group* found = nullptr;
+  const int rc = ::getgrnam_r(name.c_str(), &g, buf.data(), buf.size(), &found);
+  if (rc != 0 || !found)
+    throw std::runtime_error(std::string(key) + ": no group '" + name + "' on this machine" +
+                             (rc ? std::string(" (") + std::strerror(rc) + ")" : ""));
+  return found->gr_gid;
+}
+}  // namespace
+
+SocketAccess socketAccessFrom(const Config& config) {
+  SocketAccess a;
+  a.mode = parseSocketMode(config.socket.mode).value_or(0660);
+  if (!config.socket.group.empty()) a.group = groupId(config.socket.group, "socket.group");
+  return a;
+}
+
 ServerLimits serverLimitsFrom(const Config& config) {
   ServerLimits l;
+  for (const std::string& name : config.socket.allowGroups) l.allowGroups.emplace_back(name, groupId(name, "socket.allow_groups"));
   l.maxClients = config.socket.maxClients;
   l.maxRequestBytes = static_cast<std::size_t>(config.socket.maxRequestBytes);
   l.clientQueue = static_cast<std::size_t>(config.socket.clientQueue);
@@ -119,7 +142,9 @@ std::string Service::reload() {
 
 std::string Service::reload(const Config& next) {
   std::shared_ptr<const StackDetector> detector;
+  ServerLimits limits;
   try {
+    limits = serverLimitsFrom(next);  // socket.allow_groups may name a group that does not exist
     detector = detectorFrom(next, configFile_);
   } catch (const std::exception& e) {
     std::lock_guard lock(mutex_);
@@ -127,7 +152,7 @@ std::string Service::reload(const Config& next) {
     return lastReloadError_;
   }
   pipeline_->setDetector(std::move(detector));
-  server_->setLimits(serverLimitsFrom(next));
+  server_->setLimits(limits);
   spdlog::set_level(spdlog::level::from_str(next.logLevel));
   std::lock_guard lock(mutex_);
   // What else changed needs a restart (devices, socket path, fusion geometry).
@@ -138,6 +163,7 @@ std::string Service::reload(const Config& next) {
   applied.socket.maxRequestBytes = next.socket.maxRequestBytes;
   applied.socket.clientQueue = next.socket.clientQueue;
   applied.socket.clientSendBuffer = next.socket.clientSendBuffer;
+  applied.socket.allowGroups = next.socket.allowGroups;
   if (dumpConfig(applied) != dumpConfig(next))
     spdlog::warn("reload: changes outside detection, socket limits and log level take effect after a restart");
   config_ = applied;
@@ -176,6 +202,9 @@ nlohmann::json Service::status() const {
       }
       sensors.push_back(std::move(entry));
     }
+  nlohmann::json peers = nlohmann::json::array();
+  for (const Peer& peer : server_->peers())
+    peers.push_back({{"client", peer.client}, {"pid", peer.pid}, {"uid", peer.uid}, {"gid", peer.gid}, {"subscribed", peer.subscribed}});
   std::lock_guard lock(mutex_);
   return {
       {"mode", mode_},
@@ -208,7 +237,9 @@ nlohmann::json Service::status() const {
         {"dropped_slow", s.droppedSlow},
         {"disconnected", s.disconnected},
         {"bad_requests", s.badRequests},
-        {"oversized_requests", s.oversized}}},
+        {"oversized_requests", s.oversized},
+        {"refused_not_allowed", s.refusedNotAllowed},
+        {"peers", peers}}},
       {"reloads", reloads_},
       {"last_reload_error", lastReloadError_}};
 }

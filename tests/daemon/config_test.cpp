@@ -65,6 +65,19 @@ TEST(Config, ComplexKeysAndNonFiniteNumbersAreConfigErrors) {
             "test.yaml:3: key fusion.laser_to_camera.translation: not a finite number");
 }
 
+TEST(Config, SocketAccessKeys) {
+  const Config c = parseConfig("socket:\n  mode: \"0640\"\n  group: robots\n  allow_groups: [robots, ops]\n", "t.yaml");
+  EXPECT_EQ(parseSocketMode(c.socket.mode), 0640u);
+  EXPECT_EQ(c.socket.group, "robots");
+  EXPECT_EQ(c.socket.allowGroups, (std::vector<std::string>{"robots", "ops"}));
+  EXPECT_EQ(parseConfig(dumpConfig(c), "dump.yaml").socket.allowGroups, c.socket.allowGroups);
+  EXPECT_EQ(parseSocketMode(parseConfig(dumpConfig(c), "dump.yaml").socket.mode), 0640u);
+  EXPECT_EQ(errorOf("socket:\n  mode: \"0999\"\n"),
+            "test.yaml:2: key socket.mode: '0999' is not an octal mode from 0000 to 0777");
+  EXPECT_NE(errorOf("socket:\n  mode: \"17777\"\n").find("not an octal mode"), std::string::npos);
+  EXPECT_EQ(errorOf("socket:\n  allow_groups: robots\n"), "test.yaml:2: key socket.allow_groups: wrong type");
+}
+
 TEST(Config, CameraKeys) {
   const Config c = parseConfig("camera:\n  usb: 046d:0825:ABC\n  format: auto\n  exposure: 8000\n  gain: auto\n  buffers: 6\n",
                                "cam.yaml");

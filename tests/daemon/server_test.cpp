@@ -4,8 +4,12 @@
 // every result in order; the others are dropped or answered with error lines, never stalling
 // anyone.
 
+#include <grp.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <sys/un.h>
 #include <unistd.h>
 
@@ -284,4 +288,139 @@ TEST(Server, OnlyARefusedConnectionMakesASocketFileStale) {
   other.reset();
   auto fd = bindUnixSocket(path);
   EXPECT_TRUE(fd.valid());
+}
+
+namespace {
+// The first line the server sends a client that connects as `uid`/`gid` (with `groups` as its
+// supplementary groups) and asks hello: a forked child drops to that user (the tests run as root).
+// Only async-signal-safe calls in the child: the server thread runs in the parent.
+std::string firstLineAs(const std::string& path, uid_t uid, gid_t gid, const std::vector<gid_t>& groups) {
+  int out[2];
+  if (::pipe(out) != 0) return "pipe failed";
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(out[0]);
+    if (::setgroups(groups.size(), groups.data()) != 0 || ::setgid(gid) != 0 || ::setuid(uid) != 0) ::_exit(2);
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) {
+      constexpr char kFailed[] = "connect failed";
+      [[maybe_unused]] auto w = ::write(out[1], kFailed, sizeof kFailed - 1);
+      ::_exit(3);
+    }
+    constexpr char kHello[] = "{\"cmd\":\"hello\"}\n";
+    [[maybe_unused]] auto w = ::send(fd, kHello, sizeof kHello - 1, MSG_NOSIGNAL);  // refused: may be closed
+    char buf[4096];
+    pollfd p{fd, POLLIN, 0};
+    std::size_t got = 0;
+    while (got < sizeof buf && ::poll(&p, 1, 10000) == 1) {
+      const ssize_t n = ::read(fd, buf + got, sizeof buf - got);
+      if (n <= 0) break;
+      got += static_cast<std::size_t>(n);
+      if (std::memchr(buf, '\n', got)) break;
+    }
+    [[maybe_unused]] auto w2 = ::write(out[1], buf, got);
+    ::_exit(0);
+  }
+  ::close(out[1]);
+  std::string line;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(out[0], buf, sizeof buf)) > 0;) line.append(buf, static_cast<std::size_t>(n));
+  ::close(out[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return line.substr(0, line.find('\n'));
+}
+}  // namespace
+
+// Issue 37, who may talk to the socket: the peer's pid/uid/gid (SO_PEERCRED) is known per
+// connection (status shows it); with socket.allow_groups only their members (and root, and the
+// daemon's own user) may talk - anyone else gets an error line saying why and is disconnected.
+TEST(ServerAccess, PeersAreKnownAndAllowGroupsRefusesOthers) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root: the refused client is a child dropped to uid 65534";
+  const std::string path = tempSocket("access.sock");
+  constexpr gid_t kAllowed = 31337;
+  ServerLimits limits;
+  limits.allowGroups = {{"robots", kAllowed}};
+  SocketAccess everyone;
+  everyone.mode = 0666;  // the file lets anyone in: allow_groups alone decides
+  Server server(bindUnixSocket(path, everyone), limits, {});
+  server.start();
+  Client self(path);
+  self.send({{"cmd", "subscribe"}});
+  ASSERT_TRUE(self.read(5s));
+  const auto peers = server.peers();
+  ASSERT_EQ(peers.size(), 1u);
+  EXPECT_EQ(peers[0].pid, ::getpid());
+  EXPECT_EQ(peers[0].uid, ::getuid());
+  EXPECT_EQ(peers[0].gid, ::getgid());
+  EXPECT_TRUE(peers[0].subscribed);
+
+  const std::string refused = firstLineAs(path, 65534, 65534, {});
+  const auto error = nlohmann::json::parse(refused, nullptr, false);
+  ASSERT_TRUE(error.is_object()) << refused;
+  EXPECT_EQ(error["type"], "error");
+  EXPECT_NE(error["error"].get<std::string>().find("not allowed: uid 65534"), std::string::npos) << refused;
+  EXPECT_NE(error["error"].get<std::string>().find("robots"), std::string::npos) << refused;
+  EXPECT_EQ(server.counters().refusedNotAllowed, 1u);
+
+  // A member through a supplementary group is served.
+  const std::string member = firstLineAs(path, 65534, 65534, {kAllowed});
+  const auto hello = nlohmann::json::parse(member, nullptr, false);
+  ASSERT_TRUE(hello.is_object()) << member;
+  EXPECT_EQ(hello["type"], "hello");
+  EXPECT_EQ(server.counters().refusedNotAllowed, 1u);
+  server.stop(std::chrono::steady_clock::now() + 1s);
+}
+
+// The socket file gets socket.mode and socket.group; a path in a world-writable directory that
+// someone else owns is refused, saying why; a socket passed by systemd that grants more than
+// socket.mode is refused.
+TEST(ServerAccess, SocketModeGroupAndDirectoryAreEnforced) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root: chown to other users and groups";
+  const std::filesystem::path dir = std::filesystem::path(tempSocket("x")).parent_path();
+  SocketAccess access;
+  access.mode = 0660;
+  access.group = 31337;
+  const std::string path = (dir / "modes.sock").string();
+  auto fd = bindUnixSocket(path, access);
+  struct stat st{};
+  ASSERT_EQ(::stat(path.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777u, 0660u);
+  EXPECT_EQ(st.st_gid, 31337u);
+  EXPECT_NO_THROW(checkPassedSocket(fd.get(), access));
+  SocketAccess stricter;
+  stricter.mode = 0600;
+  try {
+    checkPassedSocket(fd.get(), stricter);
+    ADD_FAILURE() << "accepted a passed socket of mode 0660 for socket.mode 0600";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("mode 0660: it lets more users connect than socket.mode 0600"), std::string::npos)
+        << e.what();
+  }
+  stricter.mode = 0644;  // only the owner may write (connect): the group's write bit is too much
+  EXPECT_THROW(checkPassedSocket(fd.get(), stricter), std::runtime_error);
+  stricter.mode = 0620;  // read bits do not matter for connecting
+  EXPECT_NO_THROW(checkPassedSocket(fd.get(), stricter));
+  SocketAccess otherGroup;
+  otherGroup.group = 4242;
+  EXPECT_THROW(checkPassedSocket(fd.get(), otherGroup), std::runtime_error);
+
+  const std::filesystem::path shared = dir / "shared";
+  std::filesystem::create_directories(shared);
+  ASSERT_EQ(::chown(shared.c_str(), 65534, 65534), 0);
+  ASSERT_EQ(::chmod(shared.c_str(), 01777), 0);
+  try {
+    (void)bindUnixSocket((shared / "x.sock").string());
+    ADD_FAILURE() << "bound a socket in a world-writable directory of another user";
+  } catch (const std::system_error& e) {
+    EXPECT_NE(std::string(e.what()).find("is world-writable"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("owned by uid 65534"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(shared / "x.sock"));
+  // Its own world-writable directory is fine.
+  ASSERT_EQ(::chown(shared.c_str(), ::geteuid(), ::getegid()), 0);
+  EXPECT_NO_THROW((void)bindUnixSocket((shared / "x.sock").string()));
 }

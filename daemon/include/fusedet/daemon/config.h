@@ -5,6 +5,7 @@
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ struct Config {
     int maxRequestBytes = 4096;
     int clientQueue = 256;
     int clientSendBuffer = 0;  // bytes (SO_SNDBUF) per client connection; 0 = the system default
+    std::string mode = "0660";  // octal: the socket file's mode
+    std::string group;          // the socket file's group; "" = the daemon's own
+    std::vector<std::string> allowGroups;  // groups whose members may talk; empty = anyone who can open it
   } socket;
 
   struct Laser {
@@ -111,6 +115,8 @@ Config loadConfig(const std::filesystem::path& file);
 Config parseConfig(const std::string& yamlText, const std::string& sourceName);
 // The effective configuration as YAML, every key present (for --check-config and status).
 std::string dumpConfig(const Config& config);
+// socket.mode ("0660") as a number; nothing unless 1-4 octal digits.
+std::optional<unsigned> parseSocketMode(const std::string& text);
 
 // The config file of the installation `executable` belongs to (the default of fusedetd --config):
 // <prefix>/etc/fusedet/fusedet.yaml, where <prefix> is the folder above the executable's bin/, and

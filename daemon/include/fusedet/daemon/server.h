@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -23,6 +24,10 @@
 namespace fusedet::daemon {
 
 struct ServerLimits {
+  // Groups whose members may talk (socket.allow_groups: name, gid); empty = whoever can open the
+  // socket file. Root and the daemon's own user are always allowed. Checked on the peer's
+  // credentials (SO_PEERCRED) and supplementary groups (/proc/PID/status) at connect.
+  std::vector<std::pair<std::string, unsigned>> allowGroups;
   int maxClients = 16;
   std::size_t maxRequestBytes = 4096;  // one request line, without its newline
   std::size_t clientQueue = 256;       // lines queued for one client before it is dropped
@@ -36,12 +41,21 @@ struct ServerCounters {
   std::size_t clients = 0;           // connected now
   std::uint64_t accepted = 0;
   std::uint64_t refused = 0;         // over max_clients
+  std::uint64_t refusedNotAllowed = 0;  // in none of socket.allow_groups
   std::uint64_t droppedSlow = 0;     // queue overflow: slow or silent clients
   std::uint64_t disconnected = 0;    // closed by the client (or a socket error)
   std::uint64_t badRequests = 0;     // not JSON, unknown cmd, ...
   std::uint64_t oversized = 0;       // request lines over the limit
   std::uint64_t linesSent = 0;       // lines queued to clients
   std::uint64_t results = 0;         // stack results published
+};
+
+// A connected client as the kernel tells it (SO_PEERCRED at connect).
+struct Peer {
+  std::uint64_t client = 0;  // the server's number for the connection (in its log lines)
+  int pid = 0;
+  unsigned uid = 0, gid = 0;
+  bool subscribed = false;
 };
 
 class Server {
@@ -66,6 +80,8 @@ class Server {
   void setLimits(const ServerLimits& limits);
 
   ServerCounters counters() const;
+  // The clients connected now, oldest first.
+  std::vector<Peer> peers() const;
   // Sensor stamp -> line handed to the clients' sockets, last 1024 stacks.
   LatencySummary latency() const { return latency_.summary(); }
   std::int64_t beatNs() const { return beat_.load(); }
@@ -81,6 +97,7 @@ class Server {
   void dispatch();
   void drop(Client& c, bool slow);
   void updateInterest(Client& c);
+  void updatePeers();
 
   drivers::UniqueFd listener_, epoll_, wake_;
   Handlers handlers_;
@@ -89,19 +106,32 @@ class Server {
   std::chrono::steady_clock::time_point deadline_;
   std::atomic<std::int64_t> beat_{0};
 
-  mutable std::mutex mutex_;  // guards limits_, pending_, latest_, counters_
+  mutable std::mutex mutex_;  // guards limits_, pending_, latest_, counters_, peers_
   ServerLimits limits_;
   std::vector<std::shared_ptr<const StackResult>> pending_;
   std::shared_ptr<const StackResult> latest_;
   ServerCounters counters_;
+  std::vector<Peer> peers_;
 
   std::vector<std::unique_ptr<Client>> clients_;  // server thread only
   std::uint64_t nextKey_ = 2;                    // server thread only; 0, 1: listener, wake
   LatencyRecorder latency_;
 };
 
-// Binds and listens on `path` (a stale socket file is replaced; a live one is an error), mode
-// 0660. Throws std::system_error naming the path.
-drivers::UniqueFd bindUnixSocket(const std::string& path);
+// Who may open the socket file: its mode and group (socket.mode, socket.group).
+struct SocketAccess {
+  unsigned mode = 0660;
+  std::optional<unsigned> group;  // gid; nothing = the daemon's own group
+};
+
+// Binds and listens on `path` (a stale socket file is replaced; a live one is an error) with
+// `access`'s mode and group. Refuses a path in a world-writable directory that the daemon's user
+// does not own (another local user could replace or pre-create the socket there). Throws
+// std::system_error naming the path and why.
+drivers::UniqueFd bindUnixSocket(const std::string& path, const SocketAccess& access = {});
+// For a socket passed by systemd (socket activation): refuses it when its file grants more than
+// `access.mode` or belongs to another group than `access.group` (when given). Throws
+// std::runtime_error saying which.
+void checkPassedSocket(int fd, const SocketAccess& access);
 
 }  // namespace fusedet::daemon

@@ -45,7 +45,10 @@ struct ServiceParts {
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile);
 // The same with a camera model already read (replay: the log's camera.yaml).
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera);
+// Throw std::runtime_error naming the key when a group of socket.group / socket.allow_groups
+// does not exist on this machine.
 ServerLimits serverLimitsFrom(const Config& config);
+SocketAccess socketAccessFrom(const Config& config);
 // Models resolve relative to the config file's folder.
 std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
 
