@@ -36,7 +36,6 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/outcomes_file.h"
 #include "fusedet/boost/paired_comparison.h"
-#include "fusedet/fusion/camera_layers.h"
 #include "fusedet/fusion/kitti_drives.h"
 #include "fusedet/fusion/kitti_import.h"
 #include "fusedet/fusion/kitti_tracks.h"
@@ -99,11 +98,6 @@ struct ExperimentOptions {
   bool minHeightFromPositives = false;
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
   std::string trainingPositives = "moderate";      // boost/class_rules.h TrainingPositives (training only)
-  // Ablations of "training that generalises" (issue 15), each off by default.
-  bool noMirror = false;                   // SampleConfig::flipPositives off
-  bool ignoredLabelsAsNegatives = false;   // SampleConfig::ignoredLabelsAsNegatives
-  std::string referenceHue = "distinctive";  // distinctive | most-frequent | DEG (TrainingConfig::ReferenceHueRule)
-  bool unmaskedHue = false;                // fusion::dropHueMask on every item, train and test
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
@@ -398,9 +392,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.validation.minHit = o.validationMinHit;
   c.minHeightFromPositives = o.minHeightFromPositives;
   c.samples.jitterCopies = o.jitter;
-  c.samples.flipPositives = !o.noMirror;
-  c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
-  boosting::setReferenceHueRule(c, o.referenceHue);
   return c;
 }
 
@@ -544,20 +535,7 @@ int runExperiments(ExperimentOptions o) {
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
-  {
-    boosting::TrainingConfig probe;
-    try {
-      boosting::setReferenceHueRule(probe, o.referenceHue);  // a bad value is refused before any work
-    } catch (const std::invalid_argument& e) {
-      throw std::runtime_error(std::string("--reference-hue: ") + e.what());
-    }
-  }
-  if (o.unmaskedHue && !o.modelsOut.empty())
-    throw std::runtime_error("--unmasked-hue cannot write --models-out: those models would meet masked hue layers at "
-                             "detection (the model does not record the ablation)");
-  // Models of unmasked hue layers saw other items than the key's ids say: their own directory.
-  const fs::path cacheRoot = o.modelCache.empty() ? o.out / "fold-models" : o.modelCache;
-  const fs::path cache = o.unmaskedHue ? cacheRoot / "hue-unmasked" : cacheRoot;
+  const fs::path cache = o.modelCache.empty() ? o.out / "fold-models" : o.modelCache;
   boosting::BootstrapConfig boot;
   boot.resamples = preset.resamples;
   boot.seed = o.seed;
@@ -625,8 +603,6 @@ int runExperiments(ExperimentOptions o) {
   std::fflush(stdout);
 
   std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(configs), driveOf);
-  if (o.unmaskedHue)
-    for (DatasetItem& item : items) fusion::dropHueMask(item.stack);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -705,15 +681,6 @@ int runExperiments(ExperimentOptions o) {
       {"jittered copies per positive", std::to_string(o.jitter)},
       {"training positives (--training-positives)", trainingPositivesText(o)},
   };
-  // Only when set: reports of default runs stay as they were.
-  if (o.noMirror) report.settings["mirrored positives (--no-mirror)"] = "off";
-  if (o.ignoredLabelsAsNegatives)
-    report.settings["negatives (--ignored-labels-as-negatives)"] =
-        "the rule before the fix: windows around ignored labels (small/occluded cars, largely covering DontCare) "
-        "may be negatives";
-  if (o.referenceHue != "distinctive") report.settings["reference hue (--reference-hue)"] = o.referenceHue;
-  if (o.unmaskedHue)
-    report.settings["hue mask (--unmasked-hue)"] = "dropped: every pixel's hue counts, grey and dark ones too";
   if (!o.classStages.empty()) {
     std::string kept;
     for (const auto& [cls, n] : o.classStages) kept += (kept.empty() ? "" : ", ") + cls + " " + std::to_string(n);
@@ -1325,23 +1292,6 @@ const bool registered = registerCommand(
                      "fold-model cache key (moderate keeps the keys it had) and written into the cached models "
                      "(boost/class_rules.h TrainingPositives)")
           ->capture_default_str();
-      app.add_flag("--no-mirror", o->noMirror,
-                   "ablation: no horizontally mirrored copies of the training positives (as `fusedet train --no-flip`); "
-                   "part of the fold-model cache key. Default: mirrored copies");
-      app.add_flag("--ignored-labels-as-negatives", o->ignoredLabelsAsNegatives,
-                   "ablation: the negative-window rule before the fix - windows around small or occluded cars, or "
-                   "larger than a DontCare region they hold, may be negatives (training_set.h "
-                   "SampleConfig::ignoredLabelsAsNegatives); part of the fold-model cache key");
-      app.add_option("--reference-hue", o->referenceHue,
-                     "reference hue of the hue_distance layer: 'distinctive' (the class's hue most over-represented "
-                     "in its positives, default), 'most-frequent' (the paper's rule, used before) or DEG for every "
-                     "class (ablations; part of the fold-model cache key)")
-          ->capture_default_str();
-      app.add_flag("--unmasked-hue", o->unmaskedHue,
-                   "ablation: drop the hue layer's mask on every frame (training and test), as imported before the "
-                   "mask: grey and dark pixels' hue counts in hue_distance and the reference hue. No re-import "
-                   "needed; fold models go to MODEL_CACHE/hue-unmasked (their key cannot see the items' masks); "
-                   "not with --models-out");
       app.add_option("--class-stages", o->classStagesText,
              "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
              "stages in every configuration and the learning curve (the same cascades as training with a stage "

@@ -44,15 +44,11 @@ struct TrainOptions {
   std::size_t negatives = 0;
   double minHeight = 25;
   int maxOcclusion = 1;
-  bool noFlip = false;
   int jitter = 0;
   int validationPart = 0;
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
-  bool vanNegative = false;
   std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
-  bool ignoredLabelsAsNegatives = false;
-  std::string referenceHue = "distinctive";
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -210,7 +206,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.samples.baseWindowHeight = o.windowHeight;
   c.samples.minPositiveHeight = o.minHeight;
   c.samples.maxOcclusion = o.maxOcclusion;
-  c.samples.flipPositives = !o.noFlip;
   c.samples.jitterCopies = o.jitter;
   c.validation.part = o.validationPart;
   c.validation.minHit = o.validationMinHit;
@@ -218,13 +213,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
   c.validation.detection.scan.step = o.evalStep;
   c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
-  if (!o.vanNegative) c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
-  c.samples.ignoredLabelsAsNegatives = o.ignoredLabelsAsNegatives;
-  try {
-    boosting::setReferenceHueRule(c, o.referenceHue);
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(std::string("--reference-hue: ") + e.what());
-  }
+  c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
   c.samples.scan.scaleFactor = o.scaleFactor;
   c.samples.scan.step = o.step;
   c.stage.minHit = o.minHit;
@@ -244,7 +233,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
     if (o.validationPart > 0)
       throw std::runtime_error("--training-positives: not with --validation-part (its held-back frames would be "
                                "scored on the training labels)");
-    if (o.vanNegative) throw std::runtime_error("--training-positives: not with --van-negative");
     trainingMatch = boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), rule);  // vans: car only
     c.samples.minPositiveHeight = trainingMatch->minHeight;
     c.samples.maxOcclusion = trainingMatch->maxOcclusion;
@@ -361,7 +349,8 @@ const bool registered = registerCommand(
       app.add_option("-o,--out", o->out, "model file to write (JSON, boost/model_io.h); default: <class>.json");
       app.add_option("--class", o->className,
                      "class to train: labels of this class are positives, every other label and the "
-                     "background are negatives (e.g. KITTI vans for car), ignore regions are skipped")
+                     "background are negatives (car: vans are ignored, as by KITTI's devkit), ignore regions are "
+                     "skipped")
           ->capture_default_str();
       app.add_option("--layers", o->layers,
                      "comma-separated layers of the joint feature pool; hue_distance is derived from hue "
@@ -403,10 +392,9 @@ const bool registered = registerCommand(
                      "hard,vans,min-height=18. Other labels of the class (and vans) are ignored, never negatives; "
                      "truncation is read as a fraction (an imported data set does not say which labels carry "
                      "tracking levels). Written into the model file (\"training_positives\"). Not with "
-                     "--validation-part or --van-negative")
+                     "--validation-part")
           ->excludes("--min-height")
           ->excludes("--max-occlusion");
-      app.add_flag("--no-flip", o->noFlip, "do not add horizontally mirrored positives");
       app.add_option("--jitter", o->jitter,
                      "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "
                      "scaled by up to +-5 %")
@@ -434,17 +422,6 @@ const bool registered = registerCommand(
                    "store the smallest training positive's height in the model as its minimum detection height "
                    "(\"min_height\"; detection scans from there unless given a minimum size); default: scan from "
                    "the base window");
-      app.add_flag("--van-negative", o->vanNegative,
-                   "car: teach vans as background (default: vans are ignored like the KITTI devkit does - no "
-                   "negative windows on them)");
-      app.add_flag("--ignored-labels-as-negatives", o->ignoredLabelsAsNegatives,
-                   "ablation: the negative-window rule before the fix - windows around small or occluded labels of "
-                   "the class, or larger than a DontCare region they hold, may be negatives; vans are background "
-                   "(the old rule knows no neighbouring class)");
-      app.add_option("--reference-hue", o->referenceHue,
-                     "reference hue of the hue_distance layer: 'distinctive' (the class's hue most over-represented in "
-                     "its positives), 'most-frequent' (the paper's rule) or DEG")
-          ->capture_default_str();
       app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
           ->capture_default_str();
       app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")

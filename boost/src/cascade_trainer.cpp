@@ -1,7 +1,6 @@
 #include "fusedet/boost/cascade_trainer.h"
 
 #include <algorithm>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <iomanip>
@@ -57,25 +56,11 @@ void TrainingConfig::validate() const {
   if (!(samples.jitterShift >= 0 && samples.jitterShift < 0.5)) bad("jitter shift must be in [0, 0.5)");
   if (!(samples.jitterScale >= 0 && samples.jitterScale < 0.5)) bad("jitter scale must be in [0, 0.5)");
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
-  if (referenceHueRule == ReferenceHueRule::kFixed && !(fixedReferenceHue >= 0 && fixedReferenceHue < 360))
-    bad("fixed reference hue must be in [0, 360) degrees");
   if (!(samples.scan.scaleFactor > 1)) bad("scan scale factor must be > 1");
   if (!(samples.scan.step > 0)) bad("scan step must be > 0");
 }
 
-void setReferenceHueRule(TrainingConfig& c, const std::string& text) {
-  using Rule = TrainingConfig::ReferenceHueRule;
-  if (text == "distinctive") return void(c.referenceHueRule = Rule::kDistinctive);
-  if (text == "most-frequent") return void(c.referenceHueRule = Rule::kMostFrequent);
-  double deg = -1;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), deg);
-  if (ec != std::errc() || end != text.data() + text.size() || !(deg >= 0 && deg < 360))
-    throw std::invalid_argument("expected distinctive, most-frequent or degrees in [0, 360), got '" + text + "'");
-  c.referenceHueRule = Rule::kFixed;
-  c.fixedReferenceHue = deg;
-}
-
-double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, bool mostFrequent) {
+double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples) {
   HueHistogram hist, background;
   for (const DatasetItem& item : items) {
     try {
@@ -86,7 +71,7 @@ double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConf
       throw std::runtime_error("reference hue: item " + item.id + ": " + e.what());
     }
   }
-  return mostFrequent ? hist.referenceHue() : hist.distinctiveHue(background);
+  return hist.distinctiveHue(background);
 }
 
 namespace {
@@ -162,13 +147,8 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   const Shard shard = job ? Shard{job->rank(), job->size()} : Shard{};
   std::optional<double> refHue;
   const auto& layers = config.pool.layers;
-  if (std::find(layers.begin(), layers.end(), "hue_distance") != layers.end()) {
-    using Rule = TrainingConfig::ReferenceHueRule;
-    const bool mostFrequent = config.referenceHueRule == Rule::kMostFrequent;
-    if (config.referenceHueRule == Rule::kFixed) refHue = config.fixedReferenceHue;
-    else refHue = job ? shardedReferenceHue(train, config.samples, shard, *job, mostFrequent)
-                      : classReferenceHue(train, config.samples, mostFrequent);
-  }
+  if (std::find(layers.begin(), layers.end(), "hue_distance") != layers.end())
+    refHue = job ? shardedReferenceHue(train, config.samples, shard, *job) : classReferenceHue(train, config.samples);
   report.referenceHue = refHue;
 
   const TrainingStacks stacks(train, layers, refHue, config.samples, shard, config.threads);
@@ -211,8 +191,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     e.message = "class " + config.className + ": " + std::to_string(pool.size()) +
                 " features in the pool (" + std::to_string(layers.size()) + " layers), " +
                 std::to_string(stacks.positives().size()) + " positives (" +
-                std::to_string(stacks.originalStacks()) + " stacks" +
-                (config.samples.flipPositives ? ", mirrored copies included" : "") + "), window " +
+                std::to_string(stacks.originalStacks()) + " stacks, mirrored copies included), window " +
                 std::to_string(cascade.windowWidth) + "x" + std::to_string(cascade.windowHeight) +
                 ", smallest positive " + std::to_string(report.minHeight) + " px high" +
                 (refHue ? ", reference hue " + fixed(*refHue, 0) + " deg" : std::string()) + ", " +

@@ -9,7 +9,7 @@
 namespace fusedet::boosting {
 
 double shardedReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, Shard shard,
-                           Collective& job, bool mostFrequent) {
+                           Collective& job) {
   HueHistogram mine, mineBackground;
   for (std::size_t i = 0; i < items.size(); ++i) {
     if (!shard.owns(i)) continue;
@@ -34,7 +34,7 @@ double shardedReferenceHue(const std::vector<DatasetItem>& items, const SampleCo
     if (const auto n = counts[static_cast<std::size_t>(b)]; n > 0) all.addHue(centre, double(n));
     if (const auto n = counts[static_cast<std::size_t>(kHueBins + b)]; n > 0) background.addHue(centre, double(n));
   }
-  return mostFrequent ? all.referenceHue() : all.distinctiveHue(background);
+  return all.distinctiveHue(background);
 }
 
 namespace {

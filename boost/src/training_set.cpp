@@ -28,16 +28,16 @@ std::vector<std::string> neighbourClasses(const std::string& className) {
 }
 
 NegativeWindowTest::NegativeWindowTest(const Labels& labels, const SampleConfig& c)
-    : maxIgnoreCoverage_(c.maxIgnoreCoverage), maxNegativeIou_(c.maxNegativeIou), oldRule_(c.ignoredLabelsAsNegatives) {
+    : maxIgnoreCoverage_(c.maxIgnoreCoverage), maxNegativeIou_(c.maxNegativeIou) {
   for (const Label& l : labels) {
-    if (oldRule_ ? l.ignore : isIgnoredLabel(l, c)) ignored_.push_back(l.box);
+    if (isIgnoredLabel(l, c)) ignored_.push_back(l.box);
     else if (l.className == c.className) positives_.push_back(l.box);
   }
 }
 
 bool NegativeWindowTest::operator()(const Box& window) const {
   for (const Box& b : ignored_)
-    if (coverage(window, b) > maxIgnoreCoverage_ || (!oldRule_ && coverage(b, window) > maxIgnoreCoverage_)) return false;
+    if (coverage(window, b) > maxIgnoreCoverage_ || coverage(b, window) > maxIgnoreCoverage_) return false;
   for (const Box& b : positives_)
     if (iou(window, b) >= maxNegativeIou_) return false;
   return true;
@@ -95,11 +95,10 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
   std::vector<std::pair<std::size_t, bool>> source;  // item index, mirrored
   for (std::size_t i = 0; i < items.size(); ++i) source.emplace_back(i, false);
   originals_ = items.size();
-  if (config_.flipPositives)
-    for (std::size_t i = 0; i < items.size(); ++i)
-      if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
-                      [&](const Label& l) { return isPositiveLabel(l, config_); }))
-        source.emplace_back(i, true);
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
+                    [&](const Label& l) { return isPositiveLabel(l, config_); }))
+      source.emplace_back(i, true);
   std::mt19937_64 rng(config_.jitterSeed);
   for (std::size_t k = 0; k < source.size(); ++k) {
     const auto [i, mirrored] = source[k];

@@ -59,13 +59,6 @@ cv::Mat hueValidMask(const cv::Mat& bgr, const HueMaskRule& rule) {
   return valid;
 }
 
-bool dropHueMask(LayerStack& stack) {
-  Layer* hue = stack.find(layer::kHue);
-  if (!hue) return false;
-  hue->valid = cv::Mat();
-  return true;
-}
-
 void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& hueRule) {
   if (bgr.type() != CV_8UC3) throw std::invalid_argument("addCameraLayers: image must be 8-bit BGR");
   stack.setReferenceSize(bgr.cols, bgr.rows);

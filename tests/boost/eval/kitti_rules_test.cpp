@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <set>
 
 #include "fusedet/boost/bootstrap.h"
 #include "fusedet/boost/class_rules.h"
@@ -307,21 +306,11 @@ TEST(CrossValidation, TrainingKeyChangesWithConfigAndItems) {
   EXPECT_NE(trainingKey(a, {"x/1", "x/2"}), trainingKey(a, {"x/1"}));
   EXPECT_NE(trainingKey(a, {"x/12"}), trainingKey(a, {"x/1", "2"}));
   EXPECT_EQ(trainingKey(a, {}).size(), 16u);
-  // Each ablation of issue 15's training changes the key; defaults name none of them.
-  for (const char* word : {"ignored_labels", "ignore_classes", "reference_hue", "jitter"})
-    EXPECT_EQ(describeTrainingConfig(a).find(word), std::string::npos) << word;
-  TrainingConfig noMirror = a, oldNegatives = a, mostFrequent = a, fixedHue = a, fixedOther = a, vans = a;
+  // Ignore classes change the key; without them the description names none.
+  EXPECT_EQ(describeTrainingConfig(a).find("ignore_classes"), std::string::npos);
+  TrainingConfig vans = a;
   vans.samples.ignoreClasses = neighbourClasses("car");
-  noMirror.samples.flipPositives = false;
-  oldNegatives.samples.ignoredLabelsAsNegatives = true;
-  setReferenceHueRule(mostFrequent, "most-frequent");
-  setReferenceHueRule(fixedHue, "215");
-  setReferenceHueRule(fixedOther, "355");
-  const std::set<std::string> keys = {trainingKey(a, {"x/1"}), trainingKey(noMirror, {"x/1"}),
-                                      trainingKey(oldNegatives, {"x/1"}), trainingKey(mostFrequent, {"x/1"}),
-                                      trainingKey(fixedHue, {"x/1"}), trainingKey(fixedOther, {"x/1"}),
-                                      trainingKey(vans, {"x/1"})};
-  EXPECT_EQ(keys.size(), 7u);
+  EXPECT_NE(trainingKey(a, {"x/1"}), trainingKey(vans, {"x/1"}));
   // A validation part changes the model, so it changes the key; without one the description
   // names none (fold models cached before it stay valid).
   EXPECT_EQ(describeTrainingConfig(a).find("validation"), std::string::npos);

@@ -217,36 +217,10 @@ TEST(CascadeTrainer, WindowsHoldingAnIgnoredLabelAreNoNegatives) {
   EXPECT_TRUE(neighbourClasses("person").empty());
 }
 
-TEST(CascadeTrainer, OldNegativeRuleLetsWindowsAroundIgnoredLabelsBeNegatives) {
-  SampleConfig s;
-  s.ignoreClasses = neighbourClasses("car");
-  Labels labels(3);
-  labels[0].className = "car";  // below 25 px: neither positive nor background
-  labels[0].box = Box{100, 100, 30, 20};
-  labels[1].className = "van";
-  labels[1].box = Box{300, 100, 40, 30};
-  labels[2].ignore = true;  // DontCare
-  labels[2].box = Box{400, 100, 30, 20};
-  const std::vector<Box> around = {Box{85, 90, 60, 40}, Box{70, 80, 90, 60}, Box{290, 95, 60, 40}, Box{385, 90, 60, 40}};
-  for (const Box& w : around) EXPECT_FALSE(isNegativeWindow(w, labels, s)) << w.x;  // the fix
-  s.ignoredLabelsAsNegatives = true;
-  // The old rule: a window 2x or 3x larger than the small car (IoU 0.25, 0.11), the van and a
-  // window 2x larger than the DontCare box (a quarter of the window in it) are all negatives.
-  for (const Box& w : around) {
-    EXPECT_TRUE(isNegativeWindow(w, labels, s)) << w.x;
-    EXPECT_TRUE(NegativeWindowTest(labels, s)(w)) << w.x;
-  }
-  // It still keeps windows on the small car (IoU >= 0.3) and inside DontCare from the negatives.
-  EXPECT_FALSE(isNegativeWindow(Box{102, 100, 30, 20}, labels, s));
-  EXPECT_FALSE(isNegativeWindow(Box{405, 105, 20, 12}, labels, s));
-}
-
-TEST(CascadeTrainer, WithoutMirroringHalfThePositivesAndNoMirroredStacks) {
+TEST(CascadeTrainer, EveryPositiveIsMirroredOnAStackOfItsOwn) {
   const std::vector<DatasetItem> items = synthetic::scenes(4, false);
-  SampleConfig s = smallConfig().samples;
+  const SampleConfig s = smallConfig().samples;
   const TrainingStacks mirrored(items, {"intensity"}, std::nullopt, s);
-  s.flipPositives = false;
-  const TrainingStacks plain(items, {"intensity"}, std::nullopt, s);
   std::size_t labelled = 0, withPositives = 0;
   for (const DatasetItem& item : items) {
     const auto n = std::count_if(item.labels.begin(), item.labels.end(), [&](const Label& l) { return isPositiveLabel(l, s); });
@@ -254,13 +228,11 @@ TEST(CascadeTrainer, WithoutMirroringHalfThePositivesAndNoMirroredStacks) {
     withPositives += n > 0 ? 1 : 0;
   }
   ASSERT_GT(labelled, 0u);
-  EXPECT_EQ(plain.positives().size(), labelled);
   EXPECT_EQ(mirrored.positives().size(), 2 * labelled);
-  EXPECT_EQ(plain.size(), items.size());
   EXPECT_EQ(mirrored.size(), items.size() + withPositives);
 }
 
-TEST(CascadeTrainer, ReferenceHueRules) {
+TEST(CascadeTrainer, ReferenceHueIsTheClassesDistinctiveHue) {
   // Hue 210 everywhere; inside the car, 40 % of the pixels red (5 degrees).
   DatasetItem item;
   item.id = "hue/1";
@@ -274,27 +246,16 @@ TEST(CascadeTrainer, ReferenceHueRules) {
   item.labels = {car};
   SampleConfig s;
   s.minPositiveHeight = 10;
-  EXPECT_DOUBLE_EQ(classReferenceHue({item}, s), 5.0);         // distinctive: red
-  EXPECT_DOUBLE_EQ(classReferenceHue({item}, s, true), 215.0);  // the paper's: most frequent
-  TrainingConfig c;
-  setReferenceHueRule(c, "most-frequent");
-  EXPECT_EQ(c.referenceHueRule, TrainingConfig::ReferenceHueRule::kMostFrequent);
-  setReferenceHueRule(c, "123.5");
-  EXPECT_EQ(c.referenceHueRule, TrainingConfig::ReferenceHueRule::kFixed);
-  EXPECT_DOUBLE_EQ(c.fixedReferenceHue, 123.5);
-  setReferenceHueRule(c, "distinctive");
-  EXPECT_EQ(c.referenceHueRule, TrainingConfig::ReferenceHueRule::kDistinctive);
-  for (const char* bad : {"", "red", "360", "-1", "12x", "nan"}) EXPECT_THROW(setReferenceHueRule(c, bad), std::invalid_argument) << bad;
-  // The trainer uses the rule: a fixed hue becomes the model's.
+  // Distinctive: the red over-represented in the car, not its most frequent hue (210, the 215 bin).
+  EXPECT_DOUBLE_EQ(classReferenceHue({item}, s), 5.0);
+  // The trainer stores that hue in the model.
   const auto items = synthetic::scenes(4, true);
-  TrainingConfig fixed = twoLayerConfig();
-  fixed.maxStages = 1;
-  setReferenceHueRule(fixed, "123");
+  TrainingConfig c = twoLayerConfig();
+  c.maxStages = 1;
   NullProgress quiet;
-  const Cascade m = trainCascade(fixed, items, quiet);
+  const Cascade m = trainCascade(c, items, quiet);
   ASSERT_TRUE(m.referenceHue.has_value());
-  EXPECT_DOUBLE_EQ(*m.referenceHue, 123.0);
-  EXPECT_NE(classReferenceHue(items, fixed.samples), 123.0);
+  EXPECT_DOUBLE_EQ(*m.referenceHue, classReferenceHue(items, c.samples));
 }
 
 TEST(CascadeTrainer, HeldBackPositivesPlaceTheStageThresholds) {

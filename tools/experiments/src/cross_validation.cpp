@@ -25,8 +25,9 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " min_cell " << c.pool.minCellSize << " size_step " << c.pool.sizeStep << " layers " << joined(c.pool.layers)
     << " types";
   for (FeatureType t : c.pool.types) d << " " << static_cast<int>(t);
+  // "flip 1": positives are always mirrored; the text stays so that cached keys stay.
   d << "\nsamples min_height " << c.samples.minPositiveHeight << " max_occlusion " << c.samples.maxOcclusion
-    << " flip " << c.samples.flipPositives << " max_negative_iou " << c.samples.maxNegativeIou
+    << " flip 1 max_negative_iou " << c.samples.maxNegativeIou
     << " max_ignore_coverage " << c.samples.maxIgnoreCoverage << " window_height " << c.samples.baseWindowHeight
     << " scan " << c.samples.scan.scaleFactor << " " << c.samples.scan.step << " " << c.samples.scan.minWidth << " "
     << c.samples.scan.minHeight << " " << c.samples.scan.maxWidth << " " << c.samples.scan.maxHeight
@@ -36,10 +37,7 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   if (c.minHeightFromPositives) d << "min_height_from_positives\n";
   // Only when set: keys of configurations without them stay as they were.
-  if (c.samples.ignoredLabelsAsNegatives) d << "ignored_labels_as_negatives\n";  // only then: keys stay as they were
-  if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";  // likewise
-  if (c.referenceHueRule == TrainingConfig::ReferenceHueRule::kMostFrequent) d << "reference_hue most_frequent\n";
-  if (c.referenceHueRule == TrainingConfig::ReferenceHueRule::kFixed) d << "reference_hue " << c.fixedReferenceHue << "\n";
+  if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";
   if (c.samples.jitterCopies > 0)
     d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
       << c.samples.jitterSeed << "\n";

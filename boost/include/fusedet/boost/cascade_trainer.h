@@ -63,12 +63,6 @@ struct TrainingConfig {
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.
   std::size_t positiveCacheBytes = std::size_t(1) << 30;
-  // Reference hue of a hue_distance layer (reference_hue.h): the class's distinctive hue
-  // (default), the paper's most frequent hue inside the positives (the rule before the distinctive
-  // one), or fixedReferenceHue degrees whatever the class. The last two are ablations.
-  enum class ReferenceHueRule { kDistinctive, kMostFrequent, kFixed };
-  ReferenceHueRule referenceHueRule = ReferenceHueRule::kDistinctive;
-  double fixedReferenceHue = 0;  // degrees in [0, 360), with kFixed
 
   // Throws std::invalid_argument naming the bad setting.
   void validate() const;
@@ -150,11 +144,7 @@ Cascade trainCascade(const TrainingConfig& config, const std::vector<DatasetItem
                      ProgressSink& progress, TrainingReport* report = nullptr, Collective* job = nullptr);
 
 // Reference hue of config.className's positives in `items` (reference_hue.h), from their hue
-// layer: their distinctive hue, or with mostFrequent the paper's most frequent one. Throws
-// std::runtime_error when no positive has hue values.
-double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, bool mostFrequent = false);
-// Sets config's reference-hue rule from "distinctive", "most-frequent" or degrees in [0, 360).
-// Throws std::invalid_argument for anything else.
-void setReferenceHueRule(TrainingConfig& config, const std::string& text);
+// layer: their distinctive hue. Throws std::runtime_error when no positive has hue values.
+double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples);
 
 }  // namespace fusedet::boosting

@@ -17,7 +17,7 @@ namespace fusedet::boosting {
 // classReferenceHue() (cascade_trainer.h) of a sharded job: each rank adds the positives of its
 // own items, the 36 pixel counts are summed over the ranks (integers: exact).
 double shardedReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples, Shard shard,
-                           Collective& job, bool mostFrequent = false);
+                           Collective& job);
 
 // TrainingStacks::harvestNegatives() of a sharded job: each rank scans its original stacks, the
 // candidate counts per stack are summed, reservoirSlots() picks the global candidates, and the

@@ -27,7 +27,6 @@ struct SampleConfig {
   // Labels of the class that become positives (KITTI "moderate" by default).
   double minPositiveHeight = 25;  // reference pixels
   int maxOcclusion = 1;
-  bool flipPositives = true;
   // Jittered copies of every positive (and of its mirrored copy): the box shifted by up to
   // jitterShift of its width/height and scaled by up to 1 +- jitterScale, drawn with jitterSeed.
   // They teach the small misalignments the detector's scan grid and the labels have.
@@ -44,12 +43,6 @@ struct SampleConfig {
   double maxNegativeIou = 0.3;
   double maxIgnoreCoverage = 0.5;
   std::vector<std::string> ignoreClasses;  // e.g. {"van"} for car: KITTI's neighbouring class
-  // The rule before the fix above (an ablation, off by default): only ignore regions count as
-  // ignored, and only when they cover more than maxIgnoreCoverage of the window (a window 2-3x
-  // larger than a DontCare box is a negative); every label of the class, positive or not, blocks
-  // windows with IoU >= maxNegativeIou (a window around a small car is a negative); ignoreClasses
-  // are not used (their labels are background).
-  bool ignoredLabelsAsNegatives = false;
   int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
   ScanParams scan;            // windows scanned for negatives (scales, step)
 };
@@ -78,7 +71,6 @@ class NegativeWindowTest {
  private:
   std::vector<Box> ignored_, positives_;
   double maxIgnoreCoverage_ = 0.5, maxNegativeIou_ = 0.3;
-  bool oldRule_ = false;  // SampleConfig::ignoredLabelsAsNegatives
 };
 
 struct NegativeHarvest {
@@ -101,7 +93,7 @@ std::vector<std::size_t> reservoirSlots(std::size_t candidates, std::size_t want
 class TrainingStacks {
  public:
   // Integrates `layers` of every item (hue_distance derived with referenceHue); stacks holding
-  // positives get a mirrored copy when config.flipPositives. Throws when an item lacks a layer.
+  // positives get a mirrored copy. Throws when an item lacks a layer.
   // With a shard, only the items this rank owns (and their mirrored copies) are integrated; the
   // others need only labels and reference size (readDatasetItemLabels()).
   // threads (1 = the calling thread, 0 = all cores) share the integrals; the result is the same.

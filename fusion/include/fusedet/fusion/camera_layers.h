@@ -28,10 +28,4 @@ cv::Mat hueValidMask(const cv::Mat& bgr, const HueMaskRule& rule = {});
 // (core/hue_distance.h) and the reference hue counts only valid ones.
 void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& hueRule = {});
 
-// The hue layer as imported before the mask existed (an ablation): its validity mask dropped, so
-// every pixel's hue counts again - a grey pixel's 0 too - in hue_distance and the reference hue.
-// The hue values are those addCameraLayers() stores either way. Returns false (stack unchanged)
-// when the stack has no hue layer.
-bool dropHueMask(LayerStack& stack);
-
 }  // namespace fusedet::fusion
