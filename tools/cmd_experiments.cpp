@@ -80,14 +80,6 @@ struct ExperimentOptions {
   double step = 0;
   int minNeighbors = 3;
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
-  bool boxFit = false;       // learned box refinement per fold (boost/box_regression.h)
-  double boxFitLambda = boosting::BoxFitParams{}.lambda;
-  double boxFitMinIou = boosting::BoxFitParams{}.minIou;
-  std::string verifier = "off";  // off | logistic | gate: group verifier per fold (boost/group_verifier.h)
-  double verifierLambda = boosting::VerifierParams{}.lambda;
-  std::string verifierFeatures = "all";  // all | compact | physical
-  double verifierLabelIou = 0;
-  bool verifierRescore = true;
   // Per-class detection settings (boost/class_detection.h, car) where the preset uses them; an
   // option given on the command line applies to every class instead.
   bool classDetection = true;
@@ -431,23 +423,6 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
     spec.parts = {trainingConfig(o, p, cls, trainedConfig(config), match)};
   }
   spec.keepStages = keptStages(o, cls);
-  if (o.boxFit) {
-    boosting::BoxFitParams fit;
-    fit.lambda = o.boxFitLambda;
-    fit.minIou = o.boxFitMinIou;
-    spec.boxFit = fit;
-  }
-  if (o.verifier != "off") {
-    boosting::VerifierParams v;
-    v.kind = o.verifier == "gate" ? boosting::VerifierParams::Kind::kHeightGate : boosting::VerifierParams::Kind::kLogistic;
-    v.lambda = o.verifierLambda;
-    v.features = o.verifierFeatures == "compact"    ? boosting::VerifierParams::Features::kCompact
-                 : o.verifierFeatures == "physical" ? boosting::VerifierParams::Features::kPhysical
-                                                    : boosting::VerifierParams::Features::kAll;
-    v.labelIou = o.verifierLabelIou;
-    v.rescore = o.verifierRescore;
-    spec.verifier = v;
-  }
   return spec;
 }
 
@@ -659,18 +634,6 @@ int runExperiments(ExperimentOptions o) {
       {"per-class detection (boost/class_detection.h; --no-class-detection: none)", perClassText},
       {"laser-extent box refinement (--laser-extent)",
        o.laserExtent ? "on: left/right edges widened to the distance layer's object cluster" : "off"},
-      {"learned box refinement (--box-fit)",
-       o.boxFit ? "on: per fold fitted on its training frames' detections matched at IoU >= " + shortNum(o.boxFitMinIou) +
-                      ", ridge lambda " + shortNum(o.boxFitLambda) + " (boost/box_regression.h)"
-                : "off"},
-      {"group verifier (--verifier)",
-       o.verifier == "logistic" ? "logistic: per fold fitted on its training frames' detections (hit or false alarm), L2 lambda " +
-                                      shortNum(o.verifierLambda) + ", " + o.verifierFeatures + " features" +
-                                      (o.verifierLabelIou > 0 ? ", hits at IoU " + shortNum(o.verifierLabelIou) : std::string()) +
-                                      (o.verifierRescore ? "" : ", scores kept") +
-                                      ", threshold at the highest training F (boost/group_verifier.h)"
-       : o.verifier == "gate"   ? "gate: per fold, pixel height x distance within the 2nd-98th percentiles of its training hits'"
-                                : "off"},
       {"van for car", boosting::toString(van)},
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
                                          : "the devkit's: car " + shortNum(boosting::kittiMinOverlap("car")) +
@@ -693,7 +656,6 @@ int runExperiments(ExperimentOptions o) {
     std::fflush(stdout);
   };
   std::map<std::string, std::map<std::string, std::vector<boosting::FrameOutcome>>> framesOf;  // class, config
-  std::map<std::string, boosting::FoldFits> allFits;  // class: the `all` run's fitted steps
 
   // Peer (person only): OpenCV's HOG people detector on every frame (it is not trained here).
   if (o.peers && std::find(o.classes.begin(), o.classes.end(), "person") != o.classes.end()) {
@@ -730,9 +692,6 @@ int runExperiments(ExperimentOptions o) {
   std::vector<std::size_t> learning;  // 0 ("all") = every training drive of the fold
   for (std::size_t k : preset.learningDrives) learning.push_back(k == 0 ? mostDrives : std::min(k, mostDrives));
   report.learningFolds = foldsText(learningFolds.size(), driveCount);
-  // The steps fitted after grouping are the same for every class and configuration (chainFor).
-  if (!o.classes.empty())
-    report.chain = boosting::fittedStepsName(chainFor(o, preset, o.classes.front(), "all", matchFor(o.classes.front())));
 
   // Training labels per class: positives by --training-positives (boost/class_rules.h), every
   // other label of the class an ignored label; the test frames keep their labels (evaluation).
@@ -784,7 +743,7 @@ int runExperiments(ExperimentOptions o) {
       if (!pr.empty())
         cv::imwrite((o.out / ("pr_" + cls + ".png")).string(),
                     lineChart(cls + ": precision-recall, all folds pooled", "recall", "precision", 1.0, pr));
-      if (const cv::Mat chart = learningChart(cls, report.learning, report.chain); !chart.empty())
+      if (const cv::Mat chart = learningChart(cls, report.learning); !chart.empty())
         cv::imwrite((o.out / ("learning_" + cls + ".png")).string(), chart);
     }
     const std::map<std::string, double> targets = {{"car", 0.8}, {"bike", 0.6}, {"person", 0.5}};
@@ -882,7 +841,6 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if (config == "all") allFits[cls] = boosting::countFits(cv);
     if ((config == "all" || config == "channels") && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
@@ -964,7 +922,6 @@ int runExperiments(ExperimentOptions o) {
       p.trainingCounts = m.trainingCounts;
       p.trainingF = m.trainingF;
       p.trainingAp = m.trainingAp;
-      p.fits = m.fits;
     } else {
       boosting::ChainSpec spec = chainFor(o, preset, cls, "all", match);
       spec.scoreTrainingItems = preset.trainingScore;
@@ -978,7 +935,6 @@ int runExperiments(ExperimentOptions o) {
       for (std::size_t f = 0; headline && f < sub.size(); ++f) headline = sub[f].train == folds[f].train;
       if (headline) {
         frames = framesOf[cls]["all"];
-        p.fits = allFits[cls];
       } else {
         std::printf("%s / all, %s (learning curve, %s):\n", cls.c_str(), what.c_str(), report.learningFolds.c_str());
         const boosting::CrossValidationResult cv =
@@ -986,7 +942,6 @@ int runExperiments(ExperimentOptions o) {
         report.trainSeconds += cv.trainSeconds;
         foldModels.insert(cv.models.begin(), cv.models.end());
         frames = cv.frames;
-        p.fits = boosting::countFits(cv);
         if (spec.analyseMisses)
           report.misses.push_back({cls, "all, on its own training frames (" + report.learningFolds + ")",
                                    boosting::summariseMisses(cv.trainingPositives),
@@ -1214,45 +1169,6 @@ const bool registered = registerCommand(
                    "after grouping, widen each test-frame detection's left and right edges to where its object's "
                    "cluster in the distance layer ends (boost/laser_extent.h; default: off, but car's own setting "
                    "where the preset uses per-class detection); given, it applies to every class");
-      app.add_flag("--box-fit", o->boxFit,
-                   "learned box refinement (boost/box_regression.h): per fold, fit a ridge regression of the "
-                   "matched labels' boxes on each detection's group, member and laser features over the fold's "
-                   "TRAINING frames with its cascades, and apply it to its held-out frames (every class; a class "
-                   "with too few matched detections keeps its boxes). Default: off");
-      app.add_option("--box-fit-lambda", o->boxFitLambda, "--box-fit: ridge penalty on standardised features (> 0)")
-          ->check(CLI::PositiveNumber)
-          ->capture_default_str();
-      app.add_option("--box-fit-min-iou", o->boxFitMinIou,
-                     "--box-fit: a training detection is a sample when it overlaps its best positive label by this IoU")
-          ->check(CLI::Range(0.05, 1.0))
-          ->capture_default_str();
-      app.add_option("--verifier", o->verifier,
-                     "group verifier (boost/group_verifier.h), per fold fitted on the fold's TRAINING frames with its "
-                     "cascades and applied to its held-out frames: 'logistic' = an L2-regularised logistic regression "
-                     "on each group's member, cascade-margin, box and laser features (distance, pixel height x "
-                     "distance, measured share, spread, height above ground) whose probability becomes the score, "
-                     "groups below the threshold with the highest training F dropped; 'gate' = drop groups whose "
-                     "pixel height x distance lies outside the 2nd-98th percentiles of the training hits'; 'off'. "
-                     "Combine with a low --min-neighbors (the floor the groups are kept at). Default: off")
-          ->check(CLI::IsMember({"off", "logistic", "gate"}))
-          ->capture_default_str();
-      app.add_option("--verifier-lambda", o->verifierLambda, "--verifier logistic: L2 penalty on standardised features (> 0)")
-          ->check(CLI::PositiveNumber)
-          ->capture_default_str();
-      app.add_option("--verifier-features", o->verifierFeatures,
-                     "--verifier logistic: the features it weighs: 'all'; 'compact' = member count, aspect, height, "
-                     "cascade margins, laser and height-above-ground cues (no box or member edges); 'physical' = "
-                     "member count, laser and height-above-ground cues and their squares")
-          ->check(CLI::IsMember({"all", "compact", "physical"}))
-          ->capture_default_str();
-      app.add_flag("!--verifier-keep-score", o->verifierRescore,
-                   "--verifier logistic: only filter groups; a kept group's score stays its member count (default: "
-                   "the verifier's probability becomes the score)");
-      app.add_option("--verifier-label-iou", o->verifierLabelIou,
-                     "--verifier: a training detection counts as a hit when it overlaps a positive label by this IoU "
-                     "(0 = the evaluation's rule, e.g. the devkit's 0.7 for car)")
-          ->check(CLI::Range(0.0, 1.0))
-          ->capture_default_str();
       app.add_flag("!--no-class-detection", o->classDetection,
                    "detect every class with the general settings (--scale-factor, --step, --min-neighbors, "
                    "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "

@@ -238,11 +238,6 @@ std::string renderMarkdown(const ExperimentReport& r) {
           "drives 0005 / 0009 counts once however many frames show it; every other label once), drives, "
           "frames.";
     if (!r.learningFolds.empty()) md << " Folds: " << r.learningFolds << ".";
-    if (!r.chain.empty())
-      md << " After grouping every point runs **" << r.chain
-         << "**, fitted per fold on that point's own training frames only (tools/experiments/cross_validation.h); a fit "
-            "needs enough training detections and an unfitted step is the identity: column \"fitted\" = "
-            "folds with a fitted box fit / verifier of the folds trained.";
     md << "\n\n";
     const auto hfm = [](const boosting::Counts& c) {
       return std::to_string(c.hits) + " / " + std::to_string(c.falseAlarms) + " / " + std::to_string(c.misses);
@@ -270,9 +265,6 @@ std::string renderMarkdown(const ExperimentReport& r) {
                                perFold(p, &boosting::TrainingSetCount::items), formatEstimate(p.f),
                                formatEstimate(p.ap), hfm(p.counts), trained(p, p.trainingF), trained(p, p.trainingAp),
                                p.trainingScored ? hfm(p.trainingCounts) : "-"});
-        if (!r.chain.empty())
-          row.push_back(std::to_string(p.fits.boxFits) + " / " + std::to_string(p.fits.verifiers) + " of " +
-                        std::to_string(p.fits.trained));
         body.push_back(std::move(row));
       }
       if (body.empty()) continue;
@@ -282,7 +274,6 @@ std::string renderMarkdown(const ExperimentReport& r) {
                                        "frames per fold", "held-out F [95 % CI]", "held-out AP [95 % CI]",
                                        "held-out hits / FA / misses", "training F [95 % CI]", "training AP [95 % CI]",
                                        "training hits / FA / misses"};
-      if (!r.chain.empty()) head.push_back("fitted (box fit / verifier of trained folds)");
       table(md, head, body);
     }
     for (const std::string& cls : r.classes) md << "![learning curve " << cls << "](learning_" << cls << ".png)\n";
@@ -498,7 +489,6 @@ json toJson(const ExperimentReport& r) {
                            {"f_difference", estimateJson(c.fDifference)}, {"verdict", c.verdict},
                            {"ap_difference", estimateJson(c.apDifference)}, {"ap_verdict", c.apVerdict}});
   j["learning_curve_folds"] = r.learningFolds;
-  if (!r.chain.empty()) j["chain_after_grouping"] = r.chain;  // only then: other runs' files stay as they were
   j["learning_curve"] = json::array();
   for (const LearningPoint& p : r.learning) {
     json e{{"class", p.className}, {"axis", p.axis}, {"f_measure", estimateJson(p.f)},
@@ -516,9 +506,6 @@ json toJson(const ExperimentReport& r) {
       e["training"] = {{"f_measure", estimateJson(p.trainingF)}, {"average_precision", estimateJson(p.trainingAp)},
                        {"hits", p.trainingCounts.hits}, {"false_alarms", p.trainingCounts.falseAlarms},
                        {"misses", p.trainingCounts.misses}};
-    if (!r.chain.empty())
-      e["fitted"] = {{"trained_folds", p.fits.trained}, {"box_fit_folds", p.fits.boxFits},
-                     {"verifier_folds", p.fits.verifiers}};
     j["learning_curve"].push_back(std::move(e));
   }
   j["stage_sweep"] = json::array();
@@ -642,8 +629,7 @@ double LearningPoint::meanPositives() const {
   return sum / static_cast<double>(perFold.size());
 }
 
-cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points, const std::string& chain) {
-  const std::string name = chain.empty() ? cls : cls + " (" + chain + ")";
+cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points) {
   std::vector<cv::Mat> panels;
   for (const std::string axis : {"drives", "positives"}) {
     Series f{"F held out", {}, {}}, ap{"AP held out", {}, {}}, tf{"F training", {}, {}}, tap{"AP training", {}, {}};
@@ -668,10 +654,8 @@ cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& 
     std::vector<Series> drawn;
     for (Series* se : {&f, &ap, &tf, &tap})
       if (!se->points.empty()) drawn.push_back(std::move(*se));
-    // With a chain name the title says "vs drives / positives per fold" to fit the chart's width.
-    const std::string per = chain.empty() ? " training " : " ";
-    panels.push_back(lineChart(name + (axis == "drives" ? ": vs" + per + "drives per fold (95% CI)"
-                                                        : ": vs" + per + "positives per fold (95% CI)"),
+    panels.push_back(lineChart(cls + (axis == "drives" ? ": vs training drives per fold (95% CI)"
+                                                       : ": vs training positives per fold (95% CI)"),
                                axis == "drives" ? "training drives" : "training positives (mean of folds)", "F, AP",
                                xMax, drawn));
   }

@@ -72,9 +72,6 @@ struct LearningPoint {
   bool trainingScored = false;  // the three below are set
   boosting::Counts trainingCounts;
   Estimate trainingF, trainingAp;  // intervals over (fold, training frame) pairs
-  // With a chain that fits steps after grouping (ExperimentReport::chain): how many of the point's
-  // trained folds fitted each, on that point's training frames (boosting::countFits).
-  boosting::FoldFits fits;
 
   double meanPositives() const;  // training positives per fold, mean over folds
 };
@@ -124,9 +121,6 @@ struct ExperimentReport {
   std::vector<Claim> claims;
   std::vector<LearningPoint> learning;
   std::string learningFolds;  // the learning curve's fold design, e.g. "3 drive-disjoint folds"
-  // The steps every configuration and learning-curve point fits per fold after grouping
-  // (boosting::fittedStepsName, e.g. "box fit + gate"); "" = none (the tables stay as they were).
-  std::string chain;
   std::vector<SweepPoint> sweep;
   std::vector<MissResult> misses;
   std::vector<Goal> goals;
@@ -174,8 +168,7 @@ cv::Mat lineChart(const std::string& title, const std::string& xLabel, const std
 
 // learning_<class>.png: held-out and training F and AP against training drives per fold and, beside
 // it, against training positives per fold (whichever curves the points hold); empty Mat if none.
-// A non-empty `chain` (ExperimentReport::chain) is named in the titles.
-cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points, const std::string& chain = "");
+cv::Mat learningChart(const std::string& cls, const std::vector<LearningPoint>& points);
 
 // Writes report.md and results.json into `dir` (created if needed).
 void writeReport(const std::filesystem::path& dir, const ExperimentReport& report);

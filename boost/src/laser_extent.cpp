@@ -77,29 +77,6 @@ Box laserExtentBox(const Box& box, const LayerStack& stack, const LaserExtentPar
   return out;
 }
 
-std::optional<LaserRows> laserRows(const Box& box, const LayerStack& stack, const LaserExtentParams& p) {
-  if (!(box.w > 0) || !(box.h > 0)) return std::nullopt;
-  const LaserCells cells(stack);
-  if (cells.empty()) return std::nullopt;
-  const LaserCells::Place at = cells.place(box);
-  const std::optional<double> d0 = cells.coreDepth(at, p.minCells);
-  if (!d0) return std::nullopt;
-  std::optional<int> top, bottom;
-  for (int r = cells.row(at.y0 - p.maxMove * at.h); r <= cells.row(at.y0 + at.h + p.maxMove * at.h); ++r) {
-    int valid = 0, on = 0;
-    for (int c = at.coreFirst; c <= at.coreLast; ++c)
-      if (cells.valid(r, c)) {
-        ++valid;
-        on += std::abs(cells.distance(r, c) - *d0) <= p.tolerance ? 1 : 0;
-      }
-    if (valid == 0 || on < p.minShare * valid) continue;
-    if (!top) top = r;
-    bottom = r;
-  }
-  if (!top) return std::nullopt;
-  return LaserRows{cells.toReferenceY(*top), cells.toReferenceY(*bottom + 1)};
-}
-
 void refineToLaserExtent(std::vector<Detection>& detections, const LayerStack& stack, const LaserExtentParams& params) {
   if (!params.enabled) return;
   for (Detection& d : detections) {

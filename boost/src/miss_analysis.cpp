@@ -98,13 +98,11 @@ FrameMissAnalysis analyseMisses(const Detector& detector, const LayerStack& stac
   const Cascade& cascade = detector.cascade();
   if (cascade.isOpenCv()) throw std::invalid_argument("analyseMisses: " + cascade.source + " is an OpenCV cascade");
   FrameMissAnalysis out;
-  // Detections as detectChain() (one list of hits and fates: refineAndVerify() takes one per cascade).
-  const std::vector<std::vector<RawHit>> hitLists{detector.scan(stack, setup.scan)};
-  const std::vector<RawHit>& hits = hitLists[0];
-  std::vector<std::vector<HitFate>> fateLists(1);
-  const std::vector<HitFate>& fates = fateLists[0];
-  out.detections = groupHits(hits, setup.group, cascade.className, stack, &fateLists[0]);
-  refineAndVerify(out.detections, hitLists, fateLists, stack, setup);
+  // Detections as detectChain().
+  const std::vector<RawHit> hits = detector.scan(stack, setup.scan);
+  std::vector<HitFate> fates;
+  out.detections = groupHits(hits, setup.group, cascade.className, stack, &fates);
+  refineToLaserExtent(out.detections, stack, setup.laserExtent);
   out.match = matchDetections(out.detections, labels, match);
 
   std::map<std::tuple<double, double, double, double>, std::size_t> hitAt;  // window -> raw hit

@@ -214,40 +214,6 @@ TEST(ExperimentsReport, LearningPointsShowTrainingScoreAndWhatEachFoldTrainedOn)
   const cv::Mat two = learningChart("car", r.learning);
   EXPECT_EQ(two.cols, 2 * one.cols);
   EXPECT_TRUE(learningChart("bike", r.learning).empty());
-  // No chain fitted after grouping: no such sentence, column or field.
-  EXPECT_EQ(md.find("After grouping"), std::string::npos) << md;
-  EXPECT_FALSE(j.contains("chain_after_grouping"));
-  EXPECT_FALSE(j["learning_curve"][0].contains("fitted"));
-}
-
-TEST(ExperimentsReport, LearningPointsNameTheFittedChainAndHowManyFoldsFittedIt) {
-  ExperimentReport r;
-  r.classes = {"car"};
-  r.chain = "box fit + gate";
-  LearningPoint p;
-  p.className = "car";
-  p.axis = "positives";
-  p.requested = 8;
-  p.perFold = {{3, 10, 1, 4}, {12, 9, 2, 9}, {2, 0, 1, 0}};
-  p.f = {0.17, boosting::Interval{0.13, 0.21, 200}};
-  p.fits.trained = 2;  // the third fold has no positives: no cascade
-  p.fits.boxFits = 1;
-  p.fits.verifiers = 2;
-  r.learning.push_back(p);
-  const std::string md = renderMarkdown(r);
-  EXPECT_NE(md.find("After grouping every point runs **box fit + gate**"), std::string::npos) << md;
-  EXPECT_NE(md.find("| fitted (box fit / verifier of trained folds) |"), std::string::npos) << md;
-  EXPECT_NE(md.find("| - | 1 / 2 of 2 |"), std::string::npos) << md;  // after the training counts
-  const nlohmann::json j = toJson(r);
-  EXPECT_EQ(j["chain_after_grouping"], "box fit + gate");
-  EXPECT_EQ(j["learning_curve"][0]["fitted"]["trained_folds"], 2);
-  EXPECT_EQ(j["learning_curve"][0]["fitted"]["box_fit_folds"], 1);
-  EXPECT_EQ(j["learning_curve"][0]["fitted"]["verifier_folds"], 2);
-  // The chart names the chain: its title differs from the default chart's, the size does not.
-  const cv::Mat plain = learningChart("car", r.learning);
-  const cv::Mat named = learningChart("car", r.learning, r.chain);
-  ASSERT_EQ(plain.size(), named.size());
-  EXPECT_GT(cv::norm(plain, named, cv::NORM_L1), 0.0);
 }
 
 }  // namespace

@@ -92,31 +92,3 @@ TEST(LaserExtent, WithoutLaserTheBoxStays) {
   EXPECT_NEAR(dets[0].unitBox.w, 0.43, 1e-12);
   EXPECT_NEAR(dets[0].unitBox.h, 0.6, 1e-12);
 }
-
-// laserRows(): the object's rows 10..39 (of the scene above) around a box, searched from 0.3 x the
-// box's height above it to as far below. Box rows 15..35 (h 20): searched rows 9..41 -> 10 .. 40
-// (bottom exclusive). A flat box 20..30 (h 10, searched 17..33) sees the object in every searched
-// row: 17 .. 34. A laser grid of half the resolution gives reference pixels x 2. No laser: nothing.
-TEST(LaserRows, RowsOfTheObjectAroundTheBox) {
-  const LayerStack s = scene(100, 50, 100, 50, 20, 59);
-  const std::optional<LaserRows> r = laserRows(Box{25, 15, 30, 20}, s, on());
-  ASSERT_TRUE(r.has_value());
-  EXPECT_DOUBLE_EQ(r->top, 10);
-  EXPECT_DOUBLE_EQ(r->bottom, 40);
-  const std::optional<LaserRows> flat = laserRows(Box{25, 20, 30, 10}, s, on());
-  ASSERT_TRUE(flat.has_value());
-  EXPECT_DOUBLE_EQ(flat->top, 17);
-  EXPECT_DOUBLE_EQ(flat->bottom, 34);
-  const std::optional<LaserRows> half = laserRows(Box{50, 30, 60, 40}, scene(200, 100, 100, 50, 20, 59), on());
-  ASSERT_TRUE(half.has_value());
-  EXPECT_DOUBLE_EQ(half->top, 20);
-  EXPECT_DOUBLE_EQ(half->bottom, 80);
-  LaserExtentParams off = on();
-  off.enabled = false;  // a measurement: `enabled` does not matter
-  EXPECT_TRUE(laserRows(Box{25, 15, 30, 20}, s, off).has_value());
-  EXPECT_FALSE(laserRows(Box{25, 15, 30, 20}, LayerStack(100, 50), on()).has_value());
-  LayerStack masked = scene(100, 50, 100, 50, 20, 59);
-  masked.find(layer::kDistance)->valid = cv::Mat(50, 100, CV_8U, cv::Scalar(0));
-  EXPECT_FALSE(laserRows(Box{25, 15, 30, 20}, masked, on()).has_value());
-  EXPECT_FALSE(laserRows(Box{25, 15, 0, 20}, s, on()).has_value());
-}

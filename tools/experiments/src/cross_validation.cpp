@@ -109,23 +109,6 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
   return cascade;
 }
 
-std::string fittedStepsName(const ChainSpec& spec) {
-  std::string name;
-  if (spec.boxFit) name = "box fit";
-  if (spec.verifier)
-    name += std::string(name.empty() ? "" : " + ") +
-            (spec.verifier->kind == VerifierParams::Kind::kHeightGate ? "gate" : "logistic verifier");
-  return name;
-}
-
-FoldFits countFits(const CrossValidationResult& result) {
-  FoldFits f;
-  f.trained = result.summaries.size();
-  for (const BoxRegression& b : result.boxFits) f.boxFits += b.fitted() ? 1 : 0;
-  for (const GroupVerifier& v : result.verifiers) f.verifiers += v.fitted() ? 1 : 0;
-  return f;
-}
-
 CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
                                     const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
                                     const MatchConfig& match, const DetectionSetup& setup,
@@ -179,32 +162,11 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     }
     std::vector<const Detector*> chain;
     for (const Detector& d : detectors) chain.push_back(&d);
-    DetectionSetup foldSetup = setup;
-    if (spec.boxFit) {
-      foldSetup.boxRegression = fitBoxRefinement(chain, testItems, fold.train, match, setup, *spec.boxFit);
-      out.boxFits.push_back(foldSetup.boxRegression);
-      if (log)
-        log("fold " + shortName + ": box refinement " +
-            (foldSetup.boxRegression.fitted() ? "fitted on " + std::to_string(foldSetup.boxRegression.samples) +
-                                                    " training detections"
-                                              : "not fitted (" + foldSetup.boxRegression.why + ")"));
-    }
-    if (spec.verifier) {
-      foldSetup.verifier = fitGroupVerification(chain, testItems, fold.train, match, foldSetup, *spec.verifier);
-      out.verifiers.push_back(foldSetup.verifier);
-      if (log) {
-        const GroupVerifier& v = foldSetup.verifier;
-        log("fold " + shortName + ": group verifier " +
-            (v.fitted() ? "fitted on " + std::to_string(v.samples) + " training detections (" + std::to_string(v.hits) +
-                              " hits)"
-                        : "not fitted (" + v.why + ")"));
-      }
-    }
-    const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, foldSetup);
+    const EvalOutcome eval = evaluateChain(chain, testItems, fold.test, match, setup);
     for (std::size_t k = 0; k < fold.test.size(); ++k) out.frames[fold.test[k]] = eval.frames[k];
     // The analysis detects on its own; it must see exactly what the evaluation saw.
     const auto explain = [&](const DatasetItem& item, const StackMatch& evaluated) {
-      FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, foldSetup);
+      FrameMissAnalysis a = analyseMisses(detectors.front(), item.stack, item.labels, match, setup);
       if (a.match.hits != evaluated.hits || a.match.falseAlarms != evaluated.falseAlarms)
         throw std::logic_error("crossValidate: the miss analysis detected differently from the evaluation on " + item.id);
       return std::move(a.positives);
@@ -217,7 +179,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
     detected += fold.test.size();
     std::size_t trainHits = 0, trainFalseAlarms = 0, trainPositives = 0;
     if (spec.scoreTrainingItems) {
-      const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, foldSetup);
+      const EvalOutcome own = evaluateChain(chain, testItems, fold.train, match, setup);
       out.trainingFrames.insert(out.trainingFrames.end(), own.frames.begin(), own.frames.end());
       if (spec.analyseMisses)
         for (std::size_t k = 0; k < fold.train.size(); ++k)

@@ -1,7 +1,7 @@
 #pragma once
 // A stack's `distance` layer read in boxes given in the stack's reference pixels: the one place
 // that says which laser cells a box covers and what distance the box is at, e.g. for the
-// laser-extent refinement (laser_extent.h: reference distance, column walk, laserRows).
+// laser-extent refinement (laser_extent.h: reference distance, column walk).
 //
 // A cell is valid when the layer's mask (if any) is non-zero there and its distance is finite and
 // > 0. A box maps onto the cells through unit coordinates (the layer has its own resolution). Its

@@ -24,7 +24,6 @@
 //    box. A walk that reaches its limit finds no end (a neighbour, a wall): that edge stays.
 // Top and bottom stay: the laser passes through windows and meets the ground under the car.
 
-#include <optional>
 #include <vector>
 
 #include "fusedet/core/box.h"
@@ -45,17 +44,6 @@ struct LaserExtentParams {
 // The refined box (reference pixels of `stack`); `box` itself when params.enabled is false, the
 // stack has no distance layer, or the box too few laser cells.
 Box laserExtentBox(const Box& box, const LayerStack& stack, const LaserExtentParams& params);
-
-// The rows the box's object occupies in the distance layer (reference pixels, bottom exclusive): of
-// the rows from maxMove x the box's height above it to as far below it, those whose valid cells in
-// the box's middle half of columns lie at least minShare within tolerance of the band's reference
-// distance (as above); the first and last such row. Nothing when no laser cell is on the box (or
-// no distance layer). Ignores `enabled` (a measurement, not a refinement; box_regression.h uses it).
-// The laser also meets the ground just under an object: `bottom` may lie a little below it.
-struct LaserRows {
-  double top = 0, bottom = 0;
-};
-std::optional<LaserRows> laserRows(const Box& box, const LayerStack& stack, const LaserExtentParams& params);
 
 // Every detection's box (and unitBox) refined in place.
 void refineToLaserExtent(std::vector<Detection>& detections, const LayerStack& stack, const LaserExtentParams& params);

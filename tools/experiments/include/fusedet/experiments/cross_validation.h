@@ -12,7 +12,6 @@
 #include <filesystem>
 #include <functional>
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,10 +70,6 @@ struct CrossValidationResult {
   // With both analyseMisses and scoreTrainingItems: the same per (fold, training item), in the
   // order of trainingFrames - where a cascade loses the objects it was trained on.
   std::vector<std::vector<PositiveOutcome>> trainingPositives;
-  // With ChainSpec::boxFit: per trained fold, the refinement fitted on its training items.
-  std::vector<BoxRegression> boxFits;
-  // With ChainSpec::verifier: per trained fold, the group verifier fitted on its training items.
-  std::vector<GroupVerifier> verifiers;
 };
 
 // A configuration: one or more training configs whose cascades are chained (AND) at detection.
@@ -90,35 +85,11 @@ struct ChainSpec {
   // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives
   // (and, with scoreTrainingItems, into trainingPositives); needs a chain of one cascade.
   bool analyseMisses = false;
-  // Fit the learned box refinement (box_regression.h) per fold on the fold's own training items
-  // with the fold's cascades, apply it on its held-out items (and its training items when they are
-  // scored): no held-out frame informs its own boxes. Unset = the setup's (none by default).
-  std::optional<BoxFitParams> boxFit{};
-  // Fit the group verifier (group_verifier.h) per fold alike: on the fold's own training items,
-  // with its cascades and its box refinement; applied on its held-out items (and its scored
-  // training items). Unset = the setup's (none by default).
-  std::optional<VerifierParams> verifier{};
 };
-
-// The steps `spec` fits per fold after grouping, as reports and charts name the chain: "box fit",
-// "gate" (VerifierParams::Kind::kHeightGate) or "logistic verifier", joined by " + " in the order
-// they run; "" when it fits nothing (the cascades with the setup's grouping and laser extent).
-std::string fittedStepsName(const ChainSpec& spec);
-
-// Of a crossValidate() result's trained folds, how many fitted each step: a fit needs enough
-// training detections (BoxFitParams / VerifierParams::minSamples), an unfitted step is the
-// identity, so a point trained on few frames may run fewer steps than its name says.
-struct FoldFits {
-  std::size_t trained = 0;    // folds with a cascade
-  std::size_t boxFits = 0;    // of them with a fitted box refinement
-  std::size_t verifiers = 0;  // of them with a fitted verifier
-};
-FoldFits countFits(const CrossValidationResult& result);
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
 // fold's test items. `progress` gets a line per fold. A learning-curve point is this run on the
-// point's folds (data_split.h learningCurveFold / learningPositivesFold): its box fit and verifier
-// are fitted per fold on that point's training items only.
+// point's folds (data_split.h learningCurveFold / learningPositivesFold).
 CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<DatasetItem>& trainingItems,
                                     const std::vector<DatasetItem>& testItems, const std::vector<Fold>& folds,
                                     const MatchConfig& match, const DetectionSetup& setup,
