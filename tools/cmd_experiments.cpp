@@ -89,7 +89,6 @@ struct ExperimentOptions {
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
-  std::string trainingPositives = "moderate";      // boost/class_rules.h TrainingPositives (training only)
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
@@ -286,19 +285,6 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
   return out;
 }
 
-// Per manifest entry: do its labels carry KITTI tracking truncation levels (0, 1, 2) instead of
-// fractions? True for the frames of a KITTI folder with its tracking label file (the drives
-// 0005 and 0009, fusion/kitti_tracks.h); an imported data set does not say, so false there.
-std::vector<bool> truncationLevelsOf(const ExperimentOptions& o, const std::vector<DatasetEntry>& manifest) {
-  std::set<std::string> tracked;
-  if (!fs::exists(o.data / "dataset.json"))
-    for (const fs::path& d : kittiDrives(o.data))
-      if (!fusion::readKittiTracks(d).frames.empty()) tracked.insert(d.filename().string());
-  std::vector<bool> out(manifest.size());
-  for (std::size_t i = 0; i < manifest.size(); ++i) out[i] = tracked.count(manifest[i].group) > 0;
-  return out;
-}
-
 // The preset (tools/experiments/experiment_plan.h) with the options given on the command line.
 boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   boosting::ExperimentPlan p = boosting::experimentPlan(o.preset);
@@ -331,18 +317,6 @@ boosting::GroupParams groupParams(const ExperimentOptions& o) {
   return g;
 }
 
-std::string trainingPositivesText(const ExperimentOptions& o) {
-  const boosting::TrainingPositives rule = boosting::parseTrainingPositives(o.trainingPositives);
-  if (rule.isDefault()) return "moderate (the evaluation positives)";
-  std::string t = boosting::toString(rule) + " (training only: ";
-  t += rule.level == boosting::TrainingPositives::Level::kHard
-           ? "occlusion <= 2, truncation <= 0.5 / tracking level <= 1"
-           : "occlusion <= 1, truncation <= 0.3 / tracking level 0";
-  t += ", height >= " + shortNum(rule.minHeight > 0 ? rule.minHeight : 25) + " px";
-  if (rule.vans) t += ", vans as car";
-  return t + "; evaluation unchanged)";
-}
-
 std::string groupingText(const ExperimentOptions& o) {
   std::string t = "OpenCV groupRectangles rule, min neighbours " + std::to_string(o.minNeighbors);
   return t;
@@ -356,13 +330,8 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.pool.layers = tc.layers;
   c.pool.types = boosting::parseFeatureTypes(tc.types);
   c.samples.className = cls;
-  // Training positives (--training-positives): the evaluation's match widened for training only;
-  // the validation part below is scored with the evaluation's own.
-  const boosting::TrainingPositives rule = boosting::parseTrainingPositives(o.trainingPositives);
-  const boosting::MatchConfig trainMatch = boosting::trainingMatchConfig(match, rule);
-  c.samples.minPositiveHeight = trainMatch.minHeight;
-  c.samples.maxOcclusion = trainMatch.maxOcclusion;
-  if (!rule.isDefault()) c.trainingPositives = boosting::toString(rule);  // default: keys stay as they were
+  c.samples.minPositiveHeight = match.minHeight;  // the evaluation positives (KITTI moderate)
+  c.samples.maxOcclusion = match.maxOcclusion;
   c.samples.scan.scaleFactor = p.trainScaleFactor;
   c.samples.scan.step = p.trainStep;
   c.stage.maxWeak = p.maxWeak;
@@ -498,15 +467,10 @@ int runExperiments(ExperimentOptions o) {
   const boosting::VanPolicy van = boosting::parseVanPolicy(o.van);
   const auto matchFor = [&](const std::string& cls) { return boosting::matchConfigFor(cls, van, o.minIou); };
   o.classStages = parseClassStages(o.classStagesText);
-  const boosting::TrainingPositives trainingRule = boosting::parseTrainingPositives(o.trainingPositives);
-  for (const std::string& cls : o.classes) boosting::trainingMatchConfig(matchFor(cls), trainingRule);  // vans: car only
   for (const auto& [cls, n] : o.classStages)
     if (std::find(o.classes.begin(), o.classes.end(), cls) == o.classes.end())
       throw std::runtime_error("--class-stages: class '" + cls + "' is not among --classes (" + joined(o.classes) + ")");
   const boosting::ExperimentPlan preset = planFor(o);
-  if (!trainingRule.isDefault() && preset.validationPart > 0)
-    throw std::runtime_error("--training-positives " + o.trainingPositives +
-                             ": not with --validation (its held-back frames would be scored on the training labels)");
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
@@ -552,7 +516,6 @@ int runExperiments(ExperimentOptions o) {
   std::vector<Labels> labels;
   for (const auto& e : manifest) labels.push_back(readDatasetItemLabels(dataset, e.id).labels);
   const std::vector<std::vector<std::string>> objectIds = objectIdsOf(o, manifest, labels, driveOf);
-  const std::vector<bool> truncationLevels = truncationLevelsOf(o, manifest);
   boosting::Fold everyItem;  // every item as training items: the data set's counts
   for (std::size_t i = 0; i < labels.size(); ++i) everyItem.train.push_back(i);
   for (const std::string& cls : o.classes) {
@@ -565,15 +528,6 @@ int runExperiments(ExperimentOptions o) {
     report.counts.push_back({cls, n.positives, n.ignoredLabels, n.frames, drives.size(), objects});
     std::printf("%-7s %zu positives (moderate) in %zu frames of %zu drives, %zu ignored labels, %zu distinct objects\n",
                 cls.c_str(), n.positives, n.frames, drives.size(), n.ignoredLabels, objects);
-    if (!trainingRule.isDefault()) {
-      std::size_t trainPositives = 0;
-      for (std::size_t i = 0; i < labels.size(); ++i) {
-        const boosting::MatchConfig tm = boosting::trainingMatchConfig(m, trainingRule, truncationLevels[i]);
-        trainPositives += boosting::countInstances({labels[i]}, tm).positives;
-      }
-      std::printf("%-7s %zu training positives (%s) in the whole data set\n", cls.c_str(), trainPositives,
-                  boosting::toString(trainingRule).c_str());
-    }
   }
   std::fflush(stdout);
 
@@ -642,7 +596,6 @@ int runExperiments(ExperimentOptions o) {
                                                             : "base window"},
       {"fold model cache", cache.string()},
       {"jittered copies per positive", std::to_string(o.jitter)},
-      {"training positives (--training-positives)", trainingPositivesText(o)},
   };
   if (!o.classStages.empty()) {
     std::string kept;
@@ -693,15 +646,14 @@ int runExperiments(ExperimentOptions o) {
   for (std::size_t k : preset.learningDrives) learning.push_back(k == 0 ? mostDrives : std::min(k, mostDrives));
   report.learningFolds = foldsText(learningFolds.size(), driveCount);
 
-  // Training labels per class: positives by --training-positives (boost/class_rules.h), every
-  // other label of the class an ignored label; the test frames keep their labels (evaluation).
+  // Training labels per class (boost/class_rules.h trainingLabels()): the evaluation positives,
+  // every other label of the class an ignored label; the test frames keep their labels.
   std::map<std::string, std::vector<DatasetItem>> trainItemsOf;  // layers are shared, only labels differ
   for (const std::string& cls : o.classes) {
     const boosting::MatchConfig match = matchFor(cls);
     trainItemsOf[cls] = items;
     for (std::size_t i = 0; i < items.size(); ++i)
-      trainItemsOf[cls][i].labels = boosting::trainingLabels(
-          items[i].labels, boosting::trainingMatchConfig(match, trainingRule, truncationLevels[i]));
+      trainItemsOf[cls][i].labels = boosting::trainingLabels(items[i].labels, match);
   }
 
   // Claims, goals and charts from what is measured so far; the report is rewritten after every
@@ -1197,16 +1149,6 @@ const bool registered = registerCommand(
                      "jittered copies (shifted and scaled by up to 5 %) of every training positive, besides its "
                      "mirror image, as `fusedet train --jitter` (default: 0)")
           ->check(CLI::Range(0, 20))
-          ->capture_default_str();
-      app.add_option("--training-positives", o->trainingPositives,
-                     "which labels of a class TRAIN as positives (evaluation is unchanged: KITTI moderate, Van "
-                     "ignored for car): 'moderate' (default; the evaluation positives: height >= 25 px, occlusion "
-                     "<= 1, truncation <= 0.3, tracking level 0) or 'hard' (occlusion <= 2, truncation <= 0.5, "
-                     "tracking level <= 1), optionally followed by ',vans' (car: Van labels within the same "
-                     "limits train as cars) and ',min-height=N' (N px instead of 25), e.g. hard,vans,min-height=18. "
-                     "Labels of the class outside the rule stay ignored in training (never negatives). Part of the "
-                     "fold-model cache key (moderate keeps the keys it had) and written into the cached models "
-                     "(boost/class_rules.h TrainingPositives)")
           ->capture_default_str();
       app.add_option("--class-stages", o->classStagesText,
              "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "

@@ -12,7 +12,6 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 
@@ -48,7 +47,6 @@ struct TrainOptions {
   int validationPart = 0;
   double validationMinHit = 0.98;
   bool minHeightFromPositives = false;
-  std::string trainingPositives;  // "" = --min-height / --max-occlusion (boost/class_rules.h otherwise)
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -224,20 +222,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.negativesPerStage = o.negatives;
   c.seed = o.seed;
   c.threads = o.threads;
-  // --training-positives: the class rule of boost/class_rules.h decides the positives (labels
-  // mapped by trainingLabels() below), instead of --min-height / --max-occlusion alone.
-  // Imported data sets do not say which labels carry tracking truncation levels: fractions.
-  std::optional<boosting::MatchConfig> trainingMatch;
-  if (!o.trainingPositives.empty()) {
-    const boosting::TrainingPositives rule = boosting::parseTrainingPositives(o.trainingPositives);
-    if (o.validationPart > 0)
-      throw std::runtime_error("--training-positives: not with --validation-part (its held-back frames would be "
-                               "scored on the training labels)");
-    trainingMatch = boosting::trainingMatchConfig(boosting::matchConfigFor(o.className), rule);  // vans: car only
-    c.samples.minPositiveHeight = trainingMatch->minHeight;
-    c.samples.maxOcclusion = trainingMatch->maxOcclusion;
-    c.trainingPositives = boosting::toString(rule);
-  }
   c.validate();
   if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
 
@@ -290,8 +274,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   for (std::size_t i = 0; i < trainIds.size(); ++i)
     items.push_back(shard.owns(i) ? readDatasetItem(o.data, trainIds[i], load)
                                   : readDatasetItemLabels(o.data, trainIds[i]));
-  if (trainingMatch)
-    for (DatasetItem& item : items) item.labels = boosting::trainingLabels(item.labels, *trainingMatch);
   if (talk)
     std::fprintf(stderr, "loaded %zu training items (layers %s) in %.1f s\n", items.size(), o.layers.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -322,7 +304,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"max_fa", std::to_string(o.maxFa)},
       {"stop_reason", report.stopReason},
   };
-  if (trainingMatch) info.emplace_back("training_positives", c.trainingPositives);
   if (o.validationPart > 0) {
     info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
                                              std::to_string(report.validationItems) + " items, " +
@@ -383,18 +364,6 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
           ->capture_default_str();
-      app.add_option("--training-positives", o->trainingPositives,
-                     "the class's training-positive rule (boost/class_rules.h) instead of --min-height / "
-                     "--max-occlusion (which check neither truncation nor the van rule): 'moderate' (the "
-                     "evaluation positives: height >= 25 px, occlusion <= 1, truncation <= 0.3) or 'hard' "
-                     "(occlusion <= 2, truncation <= 0.5), optionally followed by ',vans' (car: Van labels within "
-                     "the same limits train as cars) and ',min-height=N' (N px instead of 25), e.g. "
-                     "hard,vans,min-height=18. Other labels of the class (and vans) are ignored, never negatives; "
-                     "truncation is read as a fraction (an imported data set does not say which labels carry "
-                     "tracking levels). Written into the model file (\"training_positives\"). Not with "
-                     "--validation-part")
-          ->excludes("--min-height")
-          ->excludes("--max-occlusion");
       app.add_option("--jitter", o->jitter,
                      "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "
                      "scaled by up to +-5 %")

@@ -1,8 +1,5 @@
 #include "fusedet/boost/class_rules.h"
 
-#include <algorithm>
-#include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 namespace fusedet::boosting {
@@ -32,76 +29,6 @@ MatchConfig matchConfigFor(const std::string& className, VanPolicy van, double m
   if (className == "car" && van == VanPolicy::kIgnore) c.neighbourClasses = {"van", "Van"};
   if (className == "car" && van == VanPolicy::kPositive) c.aliasClasses = {"van"};
   if (className == "person") c.neighbourClasses = {"Person_sitting"};
-  return c;
-}
-
-TrainingPositives parseTrainingPositives(const std::string& text) {
-  const auto bad = [&](const std::string& why) {
-    return std::invalid_argument("training positives '" + text + "': " + why +
-                                 " (expected moderate|hard[,vans][,min-height=N])");
-  };
-  std::vector<std::string> parts;
-  std::stringstream in(text);
-  for (std::string part; std::getline(in, part, ',');) parts.push_back(part);
-  if (parts.empty() || text.back() == ',') throw bad("empty part");
-  TrainingPositives rule;
-  if (parts[0] == "moderate") rule.level = TrainingPositives::Level::kModerate;
-  else if (parts[0] == "hard") rule.level = TrainingPositives::Level::kHard;
-  else throw bad("level '" + parts[0] + "' is not moderate or hard");
-  bool heightGiven = false;
-  for (std::size_t i = 1; i < parts.size(); ++i) {
-    const std::string& p = parts[i];
-    if (p == "vans") {
-      if (rule.vans) throw bad("vans given twice");
-      rule.vans = true;
-    } else if (p.rfind("min-height=", 0) == 0) {
-      if (heightGiven) throw bad("min-height given twice");
-      const std::string number = p.substr(11);
-      std::size_t used = 0;
-      double h = 0;
-      try {
-        h = std::stod(number, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (number.empty() || used != number.size() || !std::isfinite(h) || h <= 0)
-        throw bad("min-height '" + number + "' is not a number of pixels > 0");
-      rule.minHeight = h;
-      heightGiven = true;
-    } else {
-      throw bad("unknown part '" + p + "'");
-    }
-  }
-  return rule;
-}
-
-std::string toString(const TrainingPositives& rule) {
-  std::string s = rule.level == TrainingPositives::Level::kHard ? "hard" : "moderate";
-  if (rule.vans) s += ",vans";
-  if (rule.minHeight > 0) {
-    std::ostringstream h;
-    h << rule.minHeight;
-    s += ",min-height=" + h.str();
-  }
-  return s;
-}
-
-MatchConfig trainingMatchConfig(const MatchConfig& evaluation, const TrainingPositives& rule, bool truncationLevels) {
-  MatchConfig c = evaluation;
-  if (rule.level == TrainingPositives::Level::kHard) {
-    c.maxOcclusion = 2;
-    c.maxTruncation = truncationLevels ? 1 : 0.5;
-  }
-  if (rule.minHeight > 0) c.minHeight = rule.minHeight;
-  if (rule.vans) {
-    if (evaluation.className != "car")
-      throw std::invalid_argument("training positives: vans train only as car, not as '" + evaluation.className + "'");
-    const auto isVan = [](const std::string& n) { return n == "van" || n == "Van"; };
-    c.neighbourClasses.erase(std::remove_if(c.neighbourClasses.begin(), c.neighbourClasses.end(), isVan),
-                             c.neighbourClasses.end());
-    if (std::find(c.aliasClasses.begin(), c.aliasClasses.end(), "van") == c.aliasClasses.end())
-      c.aliasClasses.push_back("van");
-  }
   return c;
 }
 

@@ -41,8 +41,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
   if (c.samples.jitterCopies > 0)
     d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
       << c.samples.jitterSeed << "\n";
-  if (!c.trainingPositives.empty())  // only then: keys of moderate (default) positives stay as they were
-    d << "training_positives " << c.trainingPositives << "\n";
   if (c.validation.part > 0) {  // only then: keys of configurations without one stay as they were
     const ValidationConfig& v = c.validation;
     d << "validation part " << v.part << " min_hit " << v.minHit << " min_positives " << v.minPositives << " max_cascade_fa "
@@ -102,7 +100,6 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
     const std::filesystem::path tmp = file.string() + ".tmp";
     saveModel(cascade, tmp, {{"training_key", key}, {"train_items", std::to_string(ids.size())},
                              {"stop_reason", r.stopReason}, {"train_seconds", std::to_string(r.seconds)},
-                             {"training_positives", config.trainingPositives.empty() ? "moderate" : config.trainingPositives},
                              {"positives", std::to_string(r.positives)}});
     std::filesystem::rename(tmp, file);  // a killed run leaves no half-written model
   }

@@ -53,12 +53,6 @@ struct TrainingConfig {
   // Store the smallest training positive's height as the model's minimum detection height
   // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
   bool minHeightFromPositives = false;
-  // Which labels the caller made training positives before the items reached the trainer
-  // (class_rules.h: toString(TrainingPositives), labels mapped by trainingLabels() with
-  // trainingMatchConfig()); "" = moderate, the evaluation positives. The trainer does not apply it
-  // (it sees the mapped labels); it is part of the fold-model cache key (describeTrainingConfig(),
-  // only when set, so default keys stay as they were) and written into cached model files.
-  std::string trainingPositives;
   // The pool's values on every positive are evaluated once per training and kept (pool x
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.

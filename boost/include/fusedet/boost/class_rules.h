@@ -33,38 +33,6 @@ MatchConfig matchConfigFor(const std::string& className, VanPolicy van = VanPoli
 // material (Truck, Tram, Misc included: they are false alarms in evaluation too).
 Labels trainingLabels(const Labels& labels, const MatchConfig& config);
 
-// Which labels of a class become TRAINING positives. Evaluation never changes (matchConfigFor():
-// KITTI moderate); this rule widens only what the trainer is shown, so that more distinct objects
-// train the cascade. Levels (the devkit's difficulty limits):
-//   moderate (default) = the evaluation positives: height >= 25 px, occlusion <= 1,
-//            truncation <= 0.3 (tracking labels: level 0);
-//   hard     = height >= 25 px, occlusion <= 2, truncation <= 0.5 (tracking labels: level <= 1).
-// minHeight > 0 replaces the level's 25 px (e.g. 18: also the smaller cars); vans (car only):
-// KITTI Van labels within the same limits train as cars (in evaluation Van stays the ignored
-// neighbouring class). A label of the class (or a van) outside the rule stays an ignored label in
-// training: its windows are never negatives.
-struct TrainingPositives {
-  enum class Level { kModerate, kHard };
-  Level level = Level::kModerate;
-  double minHeight = 0;  // pixels; 0 = the level's (25)
-  bool vans = false;
-  bool isDefault() const { return level == Level::kModerate && minHeight == 0 && !vans; }
-};
-// "moderate" | "hard", optionally followed by ",vans" and/or ",min-height=N" (N > 0 pixels), e.g.
-// "hard,vans,min-height=18". Throws std::invalid_argument naming what is wrong.
-TrainingPositives parseTrainingPositives(const std::string& text);
-// The canonical text parseTrainingPositives() reads back ("moderate" for the default).
-std::string toString(const TrainingPositives& rule);
-
-// The MatchConfig whose positives are the training positives of `rule`: `evaluation` (from
-// matchConfigFor()) with the level's limits, the minimum height and vans as aliases of car (no
-// longer neighbours). truncationLevels: the labels' truncation is a KITTI tracking level (0, 1, 2),
-// not a fraction; the hard level then keeps levels 0 and 1 (limit 1 instead of 0.5). The moderate
-// level's 0.3 keeps level 0 either way, as evaluation does. Returns `evaluation` unchanged for the
-// default rule. Throws std::invalid_argument for vans with a class other than car.
-MatchConfig trainingMatchConfig(const MatchConfig& evaluation, const TrainingPositives& rule,
-                                bool truncationLevels = false);
-
 // Per class: positives (moderate), ignored labels and frames holding a positive.
 struct InstanceCount {
   std::size_t positives = 0, ignoredLabels = 0, frames = 0;
