@@ -129,7 +129,7 @@ const bool registered = registerCommand(
                      "only this protocol: lodo (leave-one-drive-out, --folds 0) or <k>fold (e.g. 3fold, --folds 3); "
                      "default: every protocol");
       app.add_option("--config", o->filter.config,
-                     "only this configuration: all (the joint pool), no_corners, laser, camera, four, and, channels, "
+                     "only this configuration: all (the joint pool), no_corners, laser, camera, four, and, "
                      "hog; a stage-sweep point all:stages=N,nb=M (--stage-sweep); a learning-curve point "
                      "all:drives=K or all:positives=N|all; default: every configuration");
       app.add_option("--config-b", o->filter.configB,

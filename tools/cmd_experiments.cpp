@@ -104,30 +104,20 @@ struct TrainedConfig {
   std::vector<std::string> layers;
   std::string types;  // feature letters
 };
-// "channels" goes beyond the paper: the same joint pool offered the extra channels of
-// fusion/channel_layers.h as well (the data set is then imported with them).
 const std::vector<TrainedConfig>& trainedConfigs() {
-  static const std::vector<TrainedConfig> c = [] {
-    std::vector<std::string> withChannels = fusion::paperPoolLayers();
-    withChannels.insert(withChannels.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
-    return std::vector<TrainedConfig>{
-        {"all", fusion::paperPoolLayers(), "a-j"},
-        {"no_corners", fusion::paperPoolLayers(), "a-f"},
-        {"laser", {"distance", "remission"}, "a-j"},
-        {"camera", {"intensity", "hue_distance"}, "a-j"},
-        {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
-        {"channels", withChannels, "a-j"},
-    };
-  }();
+  static const std::vector<TrainedConfig> c = {
+      {"all", fusion::paperPoolLayers(), "a-j"},
+      {"no_corners", fusion::paperPoolLayers(), "a-f"},
+      {"laser", {"distance", "remission"}, "a-j"},
+      {"camera", {"intensity", "hue_distance"}, "a-j"},
+      {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
+  };
   return c;
 }
 const TrainedConfig& trainedConfig(const std::string& name) {
   for (const TrainedConfig& t : trainedConfigs())
     if (t.name == name) return t;
-  throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and, channels)");
-}
-bool wantsChannels(const std::vector<std::string>& configs) {
-  return std::find(configs.begin(), configs.end(), "channels") != configs.end();
+  throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and)");
 }
 
 std::string shortNum(double v) {
@@ -212,7 +202,7 @@ std::vector<fs::path> kittiDrives(const fs::path& root) {
 
 // The data set to use: --data itself when it is one, else the KITTI drives under it imported
 // once into the cache directory (a marker file records a finished import of the same drives).
-fs::path resolveDataset(const ExperimentOptions& o, bool channels) {
+fs::path resolveDataset(const ExperimentOptions& o) {
   if (fs::exists(o.data / "dataset.json")) {
     std::printf("data set: %s\n", o.data.c_str());
     return o.data;
@@ -225,9 +215,7 @@ fs::path resolveDataset(const ExperimentOptions& o, bool channels) {
   const fs::path cache = o.datasetCache.empty() ? o.out / "dataset" : o.datasetCache;
   std::string signature;
   for (const auto& d : drives) signature += fs::absolute(d).lexically_normal().string() + "\n";
-  fusion::KittiImportOptions import;
-  import.projection.extraChannels = channels;
-  if (import.projection.extraChannels) signature += "with channels\n";
+  const fusion::KittiImportOptions import;
   const fs::path marker = cache / "imported-from.txt";
   if (std::ifstream in(marker); in) {
     std::stringstream s;
@@ -397,9 +385,8 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
 
 // Items with their raw drive as group (the trainer's validation part holds back whole drives).
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   bool channels, const std::vector<std::string>& driveOf) {
-  std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
-  if (channels) layers.insert(layers.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
+                                   const std::vector<std::string>& driveOf) {
+  const std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
   std::vector<DatasetItem> items;
   items.reserve(entries.size());
   for (std::size_t i = 0; i < entries.size(); ++i) {
@@ -479,7 +466,7 @@ int runExperiments(ExperimentOptions o) {
   boot.resamples = preset.resamples;
   boot.seed = o.seed;
 
-  const fs::path dataset = resolveDataset(o, wantsChannels(configs));
+  const fs::path dataset = resolveDataset(o);
   const std::vector<DatasetEntry> manifest = readDatasetManifest(dataset);
   const std::vector<std::string> driveOf = drivesOf(o, manifest);
   const std::vector<boosting::Fold> folds = boosting::crossGroupFolds(driveOf, static_cast<std::size_t>(preset.folds));
@@ -531,7 +518,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  std::vector<DatasetItem> items = loadItems(dataset, manifest, wantsChannels(configs), driveOf);
+  std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -683,7 +670,6 @@ int runExperiments(ExperimentOptions o) {
       claim("joint_gt_and", "joint pool (all layers) > laser AND camera", "all", "and");
       claim("four_gt_and", "joint pool (4 layers) > laser AND camera", "four", "and");
       claim("corners_help", "corner features help (all > all without corners)", "all", "no_corners");
-      claim("channels_help", "extra channels help (joint pool + channels > all)", "channels", "all");
       if (cls == "person") claim("joint_gt_hog", "joint pool (all layers) > OpenCV HOG", "all", "hog");
       std::vector<Series> pr;
       for (const ConfigResult& r : report.results) {
@@ -793,7 +779,7 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if ((config == "all" || config == "channels") && !r.layerWeightShare.empty())
+    if (config == "all" && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
   };
@@ -1009,10 +995,9 @@ const bool registered = registerCommand(
       app.add_option("--preset", o->preset,
                      "what to run, each part overridable by the options below: bundled = the training of the "
                      "bundled models (models/README.md) and the plan of docs/results: leave-one-drive-out for "
-                     "`all` of every class (the headline) and for the paper's configurations and `channels` "
-                     "(car), learning curves of `all` on 3 drive-disjoint folds; quick = the same plan scaled "
-                     "down to a smoke test (grid 6, at most 4 stages of 5 stumps, coarse scans, 3 folds, no "
-                     "`channels`; its numbers mean little)")
+                     "`all` of every class (the headline) and for the paper's configurations (car), learning "
+                     "curves of `all` on 3 drive-disjoint folds; quick = the same plan scaled down to a smoke "
+                     "test (grid 6, at most 4 stages of 5 stumps, coarse scans, 3 folds; its numbers mean little)")
           ->check(CLI::IsMember(boosting::experimentPlanNames()))
           ->capture_default_str();
       app.add_flag_callback("--quick", [o] { o->preset = "quick"; }, "the same as --preset quick");
@@ -1020,9 +1005,7 @@ const bool registered = registerCommand(
       app.add_option("--configs", o->configs,
                      "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
                      "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
-                     "remission), and (laser AND camera; trains both), channels (beyond the paper: all seven "
-                     "layers + grad_mag, grad_0..5, height, distance_grad, features a-j; the KITTI drives are "
-                     "then imported with `import-kitti --channels`)" +
+                     "remission), and (laser AND camera; trains both)" +
                          presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
           ->delimiter(',');
       app.add_option("--config-classes", o->configClasses,
@@ -1181,7 +1164,7 @@ const bool registered = registerCommand(
           "on cascades trained on all other drives, so no physical object is on both sides. Per class "
           "(car, person, bike) and configuration the folds' outcomes are pooled: F at the operating point "
           "and AP (KITTI, 40 recall points) with 95 % bootstrap intervals over frames; the paper's claims "
-          "(joint > laser-only, > camera-only, > AND; corners help; beyond the paper: channels help) are "
+          "(joint > laser-only, > camera-only, > AND; corners help) are "
           "judged with the paired 95 % interval of the difference: \"holds\" only when it lies above 0, "
           "\"contradicted\" when it lies below 0, \"not shown\" when it contains 0 (a tie); a learning curve "
           "trains `all` on 1, 2, 4, ... drives per fold and on frames holding 8, 16, 32, ... positives per fold, each point also scored on its own training frames. OpenCV's HOG people detector runs on every frame as the person peer. Evaluation: the KITTI "

@@ -20,7 +20,6 @@ struct ImportOptions {
   double minDepth = 0.05;
   std::vector<std::string> classMap;
   bool quiet = false;
-  bool channels = false;
 };
 
 // "SRC=DST": DST "ignore" (or empty) makes SRC an ignore region.
@@ -48,7 +47,6 @@ int runImport(const ImportOptions& o) {
   options.projection.laserLayerScale = o.scale;
   options.projection.holeFillRadius = o.holeFill;
   options.projection.minDepth = o.minDepth;
-  options.projection.extraChannels = o.channels;
   for (const std::string& spec : o.classMap) applyClassMap(options.classes, spec);
 
   std::size_t frames = 0, labels = 0;
@@ -99,10 +97,6 @@ const bool registered = registerCommand(
                      "SOURCE=TARGET: map a KITTI class to a project class, or to 'ignore' for an ignore "
                      "region; repeatable. Defaults: Car=car Pedestrian=person Cyclist=bike Van=van (kept "
                      "as a hard negative for car); Truck, Tram, Misc, Person_sitting, DontCare = ignore");
-      app.add_flag("--channels", o->channels,
-                   "also write the channels beyond the paper (fusion/channel_layers.h): grad_mag and "
-                   "grad_0..grad_5 (gradient magnitude and six orientations of intensity, half resolution), "
-                   "height (above the ground plane fitted to the sweep) and distance_grad (laser grid)");
       app.add_flag("-q,--quiet", o->quiet, "print only the per-directory summary");
       app.footer(
           "Writes one item per frame: red, green, blue, intensity (8-bit) and hue (degrees) at camera\n"

@@ -79,8 +79,6 @@ const std::vector<ConfigInfo>& paperConfigs() {
       {"camera", "Tab. 5: camera only (intensity, hue distance)"},
       {"four", "Tab. 6: hue distance, intensity, distance, remission"},
       {"and", "Tab. 7: laser-only AND camera-only cascade (Tab. 4 AND Tab. 5; a detection must pass both)"},
-      {"channels", "beyond the paper: joint pool + channels (the seven layers of Tab. 2 and grad_mag, grad_0..5, "
-                   "height, distance_grad), features a-j"},
   };
   return c;
 }
@@ -90,20 +88,17 @@ std::vector<std::string> orderedLayers(const std::map<std::string, double>& shar
                                           std::string(layer::kBlue),        std::string(layer::kHueDistance),
                                           std::string(layer::kIntensity),   std::string(layer::kDistance),
                                           std::string(layer::kRemission)};
-  std::vector<std::string> known = paper;
-  known.insert(known.end(), fusion::extraChannelLayers().begin(), fusion::extraChannelLayers().end());
   std::vector<std::string> out;
-  for (const auto& l : known)
+  for (const auto& l : paper)
     if (shares.count(l)) out.push_back(l);
   for (const auto& [l, s] : shares)
-    if (std::find(known.begin(), known.end(), l) == known.end()) out.push_back(l);
+    if (std::find(paper.begin(), paper.end(), l) == paper.end()) out.push_back(l);
   return out;
 }
 
 std::vector<std::string> orderedSources(const std::set<std::string>& sources) {
   std::vector<std::string> out;
-  for (const auto s : {fusion::LayerSource::camera, fusion::LayerSource::laser, fusion::LayerSource::cameraDerived,
-                       fusion::LayerSource::laserDerived, fusion::LayerSource::unknown})
+  for (const auto s : {fusion::LayerSource::camera, fusion::LayerSource::laser, fusion::LayerSource::unknown})
     if (sources.count(fusion::toString(s))) out.push_back(fusion::toString(s));
   return out;
 }
@@ -383,8 +378,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
        << "`, all folds together. The weight of a stump is |right - left|: the amount it moves the stage sum "
           "between its two sides. Shares are weights summed per layer, divided by the total; the second "
           "table sums them per source (fusion/layer_sources.h: camera = red, green, blue, intensity, hue "
-          "distance; laser = distance, remission; camera (derived) = gradient channels of intensity; laser "
-          "(derived) = height above the ground plane, depth gradient).\n\n";
+          "distance; laser = distance, remission).\n\n";
     const std::vector<std::string> layers = orderedLayers(allLayers);
     std::vector<std::string> header{"class"};
     header.insert(header.end(), layers.begin(), layers.end());
@@ -419,7 +413,6 @@ std::string renderMarkdown(const ExperimentReport& r) {
     md << "\n";
   };
   weightShares("all", "## Weight share by layer (paper Fig. 7)\n\n");
-  weightShares("channels", "## Weight share by layer and sensor: joint pool + channels\n\n");
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";

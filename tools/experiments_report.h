@@ -140,10 +140,9 @@ struct ConfigInfo {
 };
 const std::vector<ConfigInfo>& paperConfigs();
 
-// Layer order for charts and tables: the paper's Fig. 3 order, then the extra channels
-// (fusion/layer_sources.h), unknown layers after them.
+// Layer order for charts and tables: the paper's Fig. 3 order, unknown layers after them.
 std::vector<std::string> orderedLayers(const std::map<std::string, double>& shares);
-// Source names (fusion::toString(LayerSource)) in the order camera, laser, derived, other.
+// Source names (fusion::toString(LayerSource)) in the order camera, laser, other.
 std::vector<std::string> orderedSources(const std::set<std::string>& sources);
 // weight_share_<class>.png for `all` (paper Fig. 7), weight_share_<config>_<class>.png otherwise.
 std::string weightShareChartName(const std::string& cls, const std::string& config);

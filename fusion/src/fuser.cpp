@@ -4,7 +4,6 @@
 #include <stdexcept>
 
 #include "fusedet/fusion/camera_layers.h"
-#include "fusedet/fusion/channel_layers.h"
 
 namespace fusedet::fusion {
 namespace {
@@ -45,12 +44,6 @@ LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timi
   stack.set(std::move(laser.distance));
   stack.set(std::move(laser.remission));
   t.rasteriseMs = msSince(t0);
-  if (config_.extraChannels) {
-    t0 = Clock::now();
-    addGradientChannels(stack);
-    addLaserChannels(stack, projection_.K);
-    t.channelsMs = msSince(t0);
-  }
   t.totalMs = msSince(start);
   if (timings) *timings = t;
   return stack;

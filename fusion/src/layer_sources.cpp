@@ -1,9 +1,6 @@
 #include "fusedet/fusion/layer_sources.h"
 
-#include <algorithm>
-
 #include "fusedet/core/layer_stack.h"
-#include "fusedet/fusion/channel_layers.h"
 
 namespace fusedet::fusion {
 
@@ -12,11 +9,6 @@ LayerSource layerSource(std::string_view l) {
                              layer::kHueDistance})
     if (l == c) return LayerSource::camera;
   if (l == layer::kDistance || l == layer::kRemission) return LayerSource::laser;
-  if (l == channel::kGradientMagnitude ||
-      std::find(channel::kOrientedGradient.begin(), channel::kOrientedGradient.end(), l) !=
-          channel::kOrientedGradient.end())
-    return LayerSource::cameraDerived;
-  if (l == channel::kHeight || l == channel::kDistanceGradient) return LayerSource::laserDerived;
   return LayerSource::unknown;
 }
 
@@ -24,8 +16,6 @@ std::string toString(LayerSource s) {
   switch (s) {
     case LayerSource::camera: return "camera";
     case LayerSource::laser: return "laser";
-    case LayerSource::cameraDerived: return "camera (derived)";
-    case LayerSource::laserDerived: return "laser (derived)";
     case LayerSource::unknown: break;
   }
   return "other";
@@ -36,17 +26,6 @@ const std::vector<std::string>& paperPoolLayers() {
                                              std::string(layer::kBlue),      std::string(layer::kIntensity),
                                              std::string(layer::kHueDistance), std::string(layer::kDistance),
                                              std::string(layer::kRemission)};
-  return l;
-}
-
-const std::vector<std::string>& extraChannelLayers() {
-  static const std::vector<std::string> l = [] {
-    std::vector<std::string> v{std::string(channel::kGradientMagnitude)};
-    for (std::string_view g : channel::kOrientedGradient) v.emplace_back(g);
-    v.emplace_back(channel::kHeight);
-    v.emplace_back(channel::kDistanceGradient);
-    return v;
-  }();
   return l;
 }
 

@@ -9,7 +9,7 @@ ExperimentPlan experimentPlan(const std::string& name) {
   ExperimentPlan p;
   p.name = name;
   if (name == "bundled") {  // the struct's defaults are the bundled models' training
-    p.configs = {"all", "no_corners", "laser", "camera", "and", "channels"};
+    p.configs = {"all", "no_corners", "laser", "camera", "and"};
     p.configClasses = {"car"};
     p.learningDrives = {1, 2, 4, 8, 0};
     p.learningPositives = {8, 16, 32, 64, 128, 0};
@@ -29,7 +29,6 @@ ExperimentPlan experimentPlan(const std::string& name) {
     p.classDetection = false;  // car's own scan (1.1 / 2) would be most of a smoke run's time
     p.folds = 3;
     p.resamples = 200;
-    // No `channels`: its import is the slow part (tools.experiments_quick_channels runs it).
     p.configs = {"all", "no_corners", "laser", "camera", "and"};
     p.configClasses = {"car"};
     p.learningDrives = {2, 0};

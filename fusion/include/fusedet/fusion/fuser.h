@@ -1,8 +1,7 @@
 #pragma once
 // Fuser: one camera image + one sweep -> a LayerStack with the camera layers (red, green, blue,
 // intensity, hue) at image resolution and the laser layers (distance, remission, with a validity
-// mask) at their own lower resolution, registered through the undistorted image plane; with
-// ProjectionConfig::extraChannels also the channels of channel_layers.h.
+// mask) at their own lower resolution, registered through the undistorted image plane.
 // The same code serves live data (distorted camera, extrinsics from config) and KITTI (rectified
 // camera, calib files).
 
@@ -18,7 +17,7 @@ namespace fusedet::fusion {
 
 // Wall time of each step of one fuse() call, in milliseconds.
 struct FuseTimings {
-  double undistortMs = 0, cameraLayersMs = 0, projectMs = 0, rasteriseMs = 0, channelsMs = 0, totalMs = 0;
+  double undistortMs = 0, cameraLayersMs = 0, projectMs = 0, rasteriseMs = 0, totalMs = 0;
 };
 
 class Fuser {

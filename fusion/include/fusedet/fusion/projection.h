@@ -18,8 +18,6 @@ struct ProjectionConfig {
   double laserLayerScale = 0.5;  // laser layers' size relative to the camera image, (0, 1]
   int holeFillRadius = 2;        // fill empty cells with a measured cell this close (Chebyshev)
   double minDepth = 0.05;        // [m] points closer to the image plane (or behind it) are dropped
-  // Also add the channels of channel_layers.h (grad_mag, grad_0..5, height, distance_grad).
-  bool extraChannels = false;
 };
 
 // The pinhole the points are projected with: pixel ~ K * (sweepToCamera * p), camera frame
