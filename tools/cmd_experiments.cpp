@@ -85,9 +85,6 @@ struct ExperimentOptions {
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
   std::size_t minPositives = 4;
-  int validationPart = -1;  // -1 = the preset's
-  double validationMinHit = 0.98;
-  bool minHeightFromPositives = false;
   int jitter = 0;                                  // jittered copies per positive (training_set.h)
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
@@ -288,7 +285,6 @@ boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   if (o.folds >= 0) p.folds = o.folds;
   if (o.learningFolds >= 0) p.learningFolds = o.learningFolds;
   if (o.resamples > 0) p.resamples = o.resamples;
-  if (o.validationPart >= 0) p.validationPart = o.validationPart;
   if (o.peerUpscale > 0) p.peerUpscale = o.peerUpscale;
   if (!o.configs.empty()) p.configs = o.configs;
   if (!o.configClasses.empty()) p.configClasses = o.configClasses;
@@ -331,15 +327,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.minPositives = o.minPositives;
   c.seed = o.seed;
   c.threads = o.threads;
-  // Validation part: drives of the fold's training drives (items' group = raw drive, loadItems),
-  // detected and scored as the test frames are.
-  c.validation.part = p.validationPart;
-  c.validation.detection.scan.scaleFactor = p.scaleFactor;
-  c.validation.detection.scan.step = p.step;
-  c.validation.detection.group = groupParams(o);
-  c.validation.match = match;
-  c.validation.minHit = o.validationMinHit;
-  c.minHeightFromPositives = o.minHeightFromPositives;
   c.samples.jitterCopies = o.jitter;
   return c;
 }
@@ -383,7 +370,7 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
   return spec;
 }
 
-// Items with their raw drive as group (the trainer's validation part holds back whole drives).
+// Items with their raw drive as group (the folds are drive-disjoint).
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
                                    const std::vector<std::string>& driveOf) {
   const std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
@@ -559,14 +546,6 @@ int runExperiments(ExperimentOptions o) {
       {"target false-alarm rate", shortNum(preset.targetFalseAlarm)},
       {"negatives per stage", preset.negatives ? std::to_string(preset.negatives) : "max(500, 2 x positives)"},
       {"stage min hit / max false alarm", "0.995 / " + shortNum(o.stageMaxFalseAlarm)},
-      {"validation part", preset.validationPart
-                              ? "1/" + std::to_string(preset.validationPart) +
-                                    " of each fold's training frames (whole drives, smallest first): stage " +
-                                    (o.validationMinHit > 0 ? "thresholds keep " + shortNum(o.validationMinHit) +
-                                                                  " of its positives, "
-                                                            : std::string("thresholds from the training positives, ")) +
-                                    "stage count by its F"
-                              : "none (stage thresholds from the training positives, every trained stage kept)"},
       {"seed (training and bootstrap)", std::to_string(o.seed)},
       {"bootstrap resamples", std::to_string(preset.resamples)},
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
@@ -579,8 +558,6 @@ int runExperiments(ExperimentOptions o) {
       {"hit overlap (IoU)", o.minIou > 0 ? shortNum(o.minIou) + " for every class (--min-iou)"
                                          : "the devkit's: car " + shortNum(boosting::kittiMinOverlap("car")) +
                                                ", person and bike " + shortNum(boosting::kittiMinOverlap("person"))},
-      {"minimum detection height", o.minHeightFromPositives ? "smallest training positive (model's min_height)"
-                                                            : "base window"},
       {"fold model cache", cache.string()},
       {"jittered copies per positive", std::to_string(o.jitter)},
   };
@@ -1109,20 +1086,6 @@ const bool registered = registerCommand(
                    "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
                    "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
                    "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
-      app.add_option("--validation", o->validationPart,
-                     "N >= 2: each fold's trainer holds back about 1/N of its training frames (whole drives, "
-                     "smallest first; never trained on): stage thresholds keep the min hit rate on their "
-                     "positives, and the stage count is the one with the best F on those frames (detected like "
-                     "the test frames); 0 = off (default: 0, also quick). See `fusedet train --validation-part`")
-          ->check(CLI::Range(0, 1000));
-      app.add_option("--validation-min-hit", o->validationMinHit,
-                     "with --validation: share of the held-back positives reaching a stage that it keeps; 0 = "
-                     "thresholds from the training positives (the held-back drives only choose the stage count)")
-          ->check(CLI::Range(0.0, 1.0))
-          ->capture_default_str();
-      app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
-                   "models store their smallest training positive's height as minimum detection height "
-                   "(default: detection scans from the base window)");
       app.add_option("--max-fa", o->stageMaxFalseAlarm,
                      "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
                      "longer stages whose sums average more stumps")

@@ -44,9 +44,6 @@ struct TrainOptions {
   double minHeight = 25;
   int maxOcclusion = 1;
   int jitter = 0;
-  int validationPart = 0;
-  double validationMinHit = 0.98;
-  bool minHeightFromPositives = false;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -205,12 +202,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.samples.minPositiveHeight = o.minHeight;
   c.samples.maxOcclusion = o.maxOcclusion;
   c.samples.jitterCopies = o.jitter;
-  c.validation.part = o.validationPart;
-  c.validation.minHit = o.validationMinHit;
-  c.minHeightFromPositives = o.minHeightFromPositives;
-  c.validation.detection.scan.scaleFactor = o.evalScaleFactor;
-  c.validation.detection.scan.step = o.evalStep;
-  c.validation.detection.group.minNeighbors = o.evalMinNeighbors;
   c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
   c.samples.scan.scaleFactor = o.scaleFactor;
   c.samples.scan.step = o.step;
@@ -304,13 +295,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"max_fa", std::to_string(o.maxFa)},
       {"stop_reason", report.stopReason},
   };
-  if (o.validationPart > 0) {
-    info.emplace_back("validation_part", "1/" + std::to_string(o.validationPart) + ": " +
-                                             std::to_string(report.validationItems) + " items, " +
-                                             std::to_string(report.validationPositives) + " positives, min hit " +
-                                             std::to_string(o.validationMinHit));
-    info.emplace_back("kept_stages", std::to_string(report.keptStages) + " of " + std::to_string(report.stages.size()));
-  }
   boosting::saveModel(cascade, out, info);
   std::printf("wrote %s: class %s, %zu stages, %zu stumps, window %dx%d, training %.1f s\n", out.string().c_str(),
               cascade.className.c_str(), cascade.stages.size(), cascade.weakCount(), cascade.windowWidth,
@@ -368,29 +352,6 @@ const bool registered = registerCommand(
                      "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "
                      "scaled by up to +-5 %")
           ->capture_default_str();
-      app.add_option("--validation-part", o->validationPart,
-                     "hold back about 1/N of the training items (N >= 2; 0 = off) as a validation part that is "
-                     "never trained on: whole groups (drives), smallest first, when the items come from several "
-                     "groups, else every N-th item. Each stage's threshold then keeps --validation-min-hit of the "
-                     "held-back positives reaching it (instead of --min-hit of the training positives, whose sums "
-                     "are optimistic), and "
-                     "the stage count kept is the one with the best F on the held-back frames (detection with "
-                     "--eval-scale-factor, --eval-step, --eval-min-neighbors; stage counts whose cascade accepts "
-                     "more than 1e-3 of the label-free windows are not tried). Not with mpirun. Off by default: on "
-                     "3 drive-disjoint car folds it lost (boost/README.md)")
-          ->check(CLI::Range(0, 1000))
-          ->capture_default_str();
-      app.add_option("--validation-min-hit", o->validationMinHit,
-                     "with --validation-part: share of the held-back positives reaching a stage that it keeps "
-                     "(boosting goes on until the stage's false-alarm rate at that threshold is <= --max-fa or "
-                     "--rounds is reached); lower than --min-hit because unseen positives have weak outliers; "
-                     "0 = thresholds from the training positives, the held-back part only chooses the stage count")
-          ->check(CLI::Range(0.0, 1.0))
-          ->capture_default_str();
-      app.add_flag("--min-height-from-positives", o->minHeightFromPositives,
-                   "store the smallest training positive's height in the model as its minimum detection height "
-                   "(\"min_height\"; detection scans from there unless given a minimum size); default: scan from "
-                   "the base window");
       app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
           ->capture_default_str();
       app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")
@@ -410,10 +371,10 @@ const bool registered = registerCommand(
                    "after training, report recall, precision and F-measure on the held-back items (the "
                    "rules and defaults of `fusedet eval`: the KITTI devkit's IoU >= 0.7 for car, 0.5 for person and "
                    "bike, KITTI moderate, ignore regions)");
-      app.add_option("--eval-scale-factor", o->evalScaleFactor, "detection scale step for --eval and --validation-part")
+      app.add_option("--eval-scale-factor", o->evalScaleFactor, "detection scale step for --eval")
           ->capture_default_str();
-      app.add_option("--eval-step", o->evalStep, "detection position step for --eval and --validation-part")->capture_default_str();
-      app.add_option("--eval-min-neighbors", o->evalMinNeighbors, "grouping: raw hits a detection needs (--eval, --validation-part)")
+      app.add_option("--eval-step", o->evalStep, "detection position step for --eval")->capture_default_str();
+      app.add_option("--eval-min-neighbors", o->evalMinNeighbors, "grouping: raw hits a detection needs (--eval)")
           ->capture_default_str();
       app.add_option("--mpi-timeout", o->mpiTimeout,
                      "[s] under mpirun/srun: end the job when a rank waits this long for the others in one "

@@ -30,7 +30,6 @@ void Cascade::validate() const {
   const std::string where = (source.empty() ? std::string("model") : source) + ": ";
   auto fail = [&](const std::string& what) { throw std::invalid_argument(where + what); };
   if (windowWidth <= 0 || windowHeight <= 0) fail("window size must be positive");
-  if (minHeight < 0) fail("minimum detection height must be >= 0");
   if (stages.empty()) fail("cascade has no stages");
   if (layers.empty()) fail("cascade names no layers");
   if (isOpenCv()) {

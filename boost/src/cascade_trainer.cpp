@@ -9,11 +9,8 @@
 #include <map>
 #include <stdexcept>
 
-#include "fusedet/boost/chain_evaluation.h"
-#include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/negative_miner.h"
-#include "fusedet/boost/precision_recall.h"
 #include "fusedet/boost/reference_hue.h"
 #include "fusedet/boost/sample_features.h"
 #include "fusedet/boost/sharded_samples.h"
@@ -49,10 +46,6 @@ void TrainingConfig::validate() const {
   if (!(targetFalseAlarm > 0 && targetFalseAlarm < 1)) bad("target false-alarm rate must be in (0, 1)");
   if (maxStages < 1) bad("stage limit must be >= 1");
   if (samples.jitterCopies < 0) bad("jittered copies must be >= 0");
-  if (validation.part < 0 || validation.part == 1) bad("validation part: 1/n of the items, n >= 2 (0 = off)");
-  if (!(validation.minHit >= 0 && validation.minHit <= 1)) bad("validation min hit must be in [0, 1] (0 = training thresholds)");
-  if (!(validation.maxCascadeFalseAlarm > 0 && validation.maxCascadeFalseAlarm <= 1))
-    bad("validation: largest cascade false-alarm rate tried must be in (0, 1]");
   if (!(samples.jitterShift >= 0 && samples.jitterShift < 0.5)) bad("jitter shift must be in [0, 0.5)");
   if (!(samples.jitterScale >= 0 && samples.jitterScale < 0.5)) bad("jitter scale must be in [0, 0.5)");
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
@@ -74,50 +67,6 @@ double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConf
   return hist.distinctiveHue(background);
 }
 
-namespace {
-
-// The first `stages` stages; features are added in stage order, so theirs are a prefix.
-Cascade truncated(const Cascade& c, std::size_t stages) {
-  Cascade out = firstStages(c, stages);
-  int used = -1;
-  for (const Stage& st : out.stages)
-    for (const Stump& s : st.stumps) used = std::max(used, s.feature);
-  out.features.resize(static_cast<std::size_t>(used + 1));
-  return out;
-}
-
-// F and AP of every stage count whose cascade false-alarm rate (on the training windows) is at
-// most the configured bound, on the held-back frames.
-std::vector<StageCountScore> scoreStageCounts(const Cascade& cascade, const TrainingReport& report,
-                                              const std::vector<DatasetItem>& frames, const TrainingConfig& config) {
-  MatchConfig match = config.validation.match;
-  if (match.className.empty()) {
-    match = matchConfigFor(config.className);
-    match.minHeight = config.samples.minPositiveHeight;
-    match.maxOcclusion = config.samples.maxOcclusion;
-  }
-  DetectionSetup setup = config.validation.detection;
-  if (setup.scan.threads == 0) setup.scan.threads = config.threads;
-  std::vector<StageCountScore> scores;
-  for (std::size_t k = 1; k <= cascade.stages.size(); ++k) {
-    const double fa = k < report.stages.size() ? report.stages[k].cascadeFalseAlarm : report.finalFalseAlarm;
-    if (fa > config.validation.maxCascadeFalseAlarm) continue;
-    const Detector det(truncated(cascade, k));
-    const EvalOutcome r = evaluateChain({&det}, frames, match, setup);
-    StageCountScore s;
-    s.stages = k;
-    s.f = r.counts.fMeasure();
-    s.ap = averagePrecision(allFrames(r.frames));
-    s.hits = r.counts.hits;
-    s.falseAlarms = r.counts.falseAlarms;
-    s.misses = r.counts.misses;
-    scores.push_back(s);
-  }
-  return scores;
-}
-
-}  // namespace
-
 Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetItem>& items,
                      ProgressSink& progress, TrainingReport* reportOut, Collective* job) {
   const auto t0 = Clock::now();
@@ -130,20 +79,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   const std::vector<Feature> pool = generatePool(config.pool);
   report.poolSize = pool.size();
 
-  if (job && config.validation.part > 0)
-    throw std::invalid_argument("training config: a validation part needs in-process training (not sharded)");
-  // The validation part (validation_part.h) is neither trained on nor harvested for negatives.
-  std::vector<DatasetItem> train, heldItems;
-  {
-    const std::vector<std::size_t> held = validationItems(items, config.validation.part);
-    for (std::size_t i = 0, h = 0; i < items.size(); ++i)
-      if (h < held.size() && held[h] == i) {
-        heldItems.push_back(items[i]);
-        ++h;
-      } else {
-        train.push_back(items[i]);
-      }
-  }
+  const std::vector<DatasetItem>& train = items;
   const Shard shard = job ? Shard{job->rank(), job->size()} : Shard{};
   std::optional<double> refHue;
   const auto& layers = config.pool.layers;
@@ -153,11 +89,6 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
 
   const TrainingStacks stacks(train, layers, refHue, config.samples, shard, config.threads);
   report.positives = stacks.positives().size();
-  SampleConfig heldSamples = config.samples;
-  heldSamples.jitterCopies = 0;  // the held-back positives as labelled (and mirrored)
-  const TrainingStacks held(heldItems, layers, refHue, heldSamples);
-  report.validationItems = heldItems.size();
-  report.validationPositives = held.positives().size();
   if (stacks.positives().empty())
     throw std::runtime_error("no positives of class '" + config.className + "' in " +
                              std::to_string(train.size()) + " training items (height >= " +
@@ -195,10 +126,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
                 std::to_string(cascade.windowWidth) + "x" + std::to_string(cascade.windowHeight) +
                 ", smallest positive " + std::to_string(report.minHeight) + " px high" +
                 (refHue ? ", reference hue " + fixed(*refHue, 0) + " deg" : std::string()) + ", " +
-                std::to_string(wanted) + " negatives per stage" +
-                (heldItems.empty() ? std::string()
-                                   : "; validation part: " + std::to_string(heldItems.size()) + " held-back items, " +
-                                         std::to_string(held.positives().size()) + " positives");
+                std::to_string(wanted) + " negatives per stage";
     progress.onProgress(e);
   }
 
@@ -282,21 +210,6 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
       ev.elapsedSeconds = elapsed();
       progress.onProgress(ev);
     };
-    // Held-back positives the cascade still accepts place this stage's threshold (gentle_boost.h).
-    std::vector<Sample> heldNow;
-    for (const Sample& v : held.positives())
-      if (cascade.stages.empty() || evaluateWindow(cascade, held.integrals(v.stack), v.window).accepted)
-        heldNow.push_back(v);
-    HeldOutPositives heldOut;
-    if (config.validation.minHit > 0 && !heldNow.empty() && heldNow.size() >= config.validation.minPositives) {
-      heldOut.count = heldNow.size();
-      heldOut.minHit = config.validation.minHit;
-      heldOut.values = [&](std::size_t f, std::span<float> out) {
-        for (std::size_t i = 0; i < heldNow.size(); ++i)
-          out[i] = featureValue(held.integrals(heldNow[i].stack), pool[f], heldNow[i].window);
-      };
-    }
-    const HeldOutPositives* heldPtr = heldOut.count ? &heldOut : nullptr;
     const auto tm = Clock::now();
     std::size_t matrixBytes = 0;
     double matrixSeconds = 0;
@@ -335,7 +248,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
       tb = Clock::now();
       matrixSeconds = std::chrono::duration<double>(tb - tm).count();
       matrixBytes = matrix.bytes();
-      r = trainStage(matrix, positives, raw, sc, onRound, heldPtr);
+      r = trainStage(matrix, positives, raw, sc, onRound);
     }
 
     Stage st;
@@ -345,16 +258,12 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
       if (it == cascadeIndex.end()) it = cascadeIndex.emplace(s.feature, cascade.addFeature(pool[s.feature])).first;
       st.stumps.push_back(Stump{it->second, double(s.threshold), s.left, s.right});
     }
-    const double kept = st.threshold;
     cascade.stages.push_back(std::move(st));
 
     StageReport sr;
     sr.stage = stage;
     sr.weak = static_cast<int>(r.stumps.size());
     sr.hitRate = r.hitRate;
-    sr.validationPositives = heldOut.count;
-    sr.threshold = kept;
-    sr.trainingThreshold = r.trainingThreshold;
     sr.falseAlarm = r.falseAlarm;
     sr.reachedFalseAlarm = r.reachedFalseAlarm;
     sr.positives = positives;
@@ -375,36 +284,13 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     ev.elapsedSeconds = elapsed();
     ev.message = "stage " + std::to_string(stage) + ": " + std::to_string(sr.weak) + " stumps, hit rate " +
                  fixed(r.hitRate, 4) + ", false alarms " + fixed(r.falseAlarm, 4) +
-                 (r.reachedFalseAlarm ? "" : " (round limit)") +
-                 (sr.validationPositives ? ", threshold " + sig(sr.threshold) + " from " +
-                                               std::to_string(sr.validationPositives) +
-                                               " held-back positives (training's " + sig(sr.trainingThreshold) + ")"
-                                         : std::string()) +
-                 ", " + std::to_string(positives) +
+                 (r.reachedFalseAlarm ? "" : " (round limit)") + ", " + std::to_string(positives) +
                  " positives, " + std::to_string(sr.negatives) + " negatives of " +
                  std::to_string(harvest.candidates) + " candidates in " +
                  std::to_string(harvest.windowsScanned) + " windows, " + fixed(sr.seconds, 1) + " s (scan " +
                  fixed(sr.harvestSeconds, 1) + ", features " + fixed(sr.matrixSeconds, 1) + ", boosting " +
                  fixed(sr.boostSeconds, 1) + "), matrix " + fixed(double(sr.matrixBytes) / 1e6, 0) + " MB";
     progress.onProgress(ev);
-  }
-
-  // Set only now: the negative harvest scans from the base window up, as before.
-  if (config.minHeightFromPositives) cascade.minHeight = report.minHeight;
-  report.keptStages = cascade.stages.size();
-  if (!heldItems.empty() && !cascade.stages.empty()) {
-    report.stageCountScores = scoreStageCounts(cascade, report, heldItems, config);
-    if (const auto k = chooseStageCount(report.stageCountScores)) {
-      report.keptStages = *k;
-      cascade = truncated(cascade, *k);
-    }
-    std::ostringstream line;
-    line << "; validation F by stage count (hits/false alarms/misses):";
-    for (const StageCountScore& sc : report.stageCountScores)
-      line << " " << sc.stages << ": " << formatMeasure(sc.f, 2) << " (" << sc.hits << "/" << sc.falseAlarms << "/"
-           << sc.misses << ")";
-    line << "; kept " << report.keptStages << " of " << report.stages.size() << " stages";
-    report.stopReason += line.str();
   }
 
   report.seconds = elapsed();
@@ -414,9 +300,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   done.maxStages = config.maxStages;
   done.cascadeFalseAlarm = report.finalFalseAlarm;
   done.elapsedSeconds = report.seconds;
-  // "kept K" only when a validation part chose the stage count (the plain line is matched by tests).
-  done.message = "stopped after " + std::to_string(report.stages.size()) + " stages" +
-                 (heldItems.empty() ? std::string() : ", kept " + std::to_string(cascade.stages.size())) + " (" +
+  done.message = "stopped after " + std::to_string(report.stages.size()) + " stages (" +
                  std::to_string(cascade.weakCount()) + " stumps): " + report.stopReason;
   progress.onProgress(done);
   if (reportOut) *reportOut = report;

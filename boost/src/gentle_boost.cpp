@@ -16,15 +16,8 @@ double stageThreshold(std::vector<double> scores, double minHit) {
   return t - 1e-9 * std::max(1.0, std::fabs(t));
 }
 
-namespace {
-
-// The Gentle AdaBoost loop of boostStage(). fit(weights, outputs) fits one round's stump, writes
-// f(x_i) of every sample to outputs and stores it in the result; heldOutputs(result, outputs)
-// gives the last stored stump's f on the held-out positives.
-template <class Fit, class HeldOutputs>
-StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOutputs&& heldOutputs,
-                        const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                        const HeldOutPositives* heldOut) {
+StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
+                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound) {
   if (positives == 0 || positives >= n)
     throw std::invalid_argument("trainStage: need positives and negatives (" +
                                 std::to_string(positives) + " of " + std::to_string(n) + " samples)");
@@ -32,40 +25,33 @@ StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOut
   std::vector<double> w(n);
   for (std::size_t i = 0; i < n; ++i)
     w[i] = i < positives ? 0.5 / double(positives) : 0.5 / double(n - positives);
-  std::vector<float> wf(n);
+  std::vector<float> wf(n), values(n);
   std::vector<double> score(n, 0.0);
-  std::vector<double> outputs(n);
-  const std::size_t held = heldOut ? heldOut->count : 0;
-  std::vector<double> heldScore(held, 0.0);
-  std::vector<double> heldF(held);
   StageResult result;
   for (int round = 1; round <= config.maxWeak; ++round) {
     for (std::size_t i = 0; i < n; ++i) wf[i] = static_cast<float>(w[i]);
-    RoundInfo info = fit(wf, outputs, result);
+    const FittedStump s = find(wf, values);
+    result.stumps.push_back(s);
     double sum = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const double f = outputs[i];
+      const double f = s(values[i]);
       score[i] += f;
       const double y = i < positives ? 1.0 : -1.0;
       w[i] *= std::exp(-y * f);
       sum += w[i];
     }
     for (double& v : w) v /= sum;
-    result.trainingThreshold =
+    result.threshold =
         stageThreshold(std::vector<double>(score.begin(), score.begin() + static_cast<std::ptrdiff_t>(positives)),
                        config.minHit);
-    result.threshold = result.trainingThreshold;
-    if (held > 0) {
-      heldOutputs(result, heldF);
-      for (std::size_t i = 0; i < held; ++i) heldScore[i] += heldF[i];
-      result.threshold = stageThreshold(heldScore, heldOut->minHit);
-    }
     std::size_t hits = 0, fas = 0;
     for (std::size_t i = 0; i < n; ++i)
       if (score[i] >= result.threshold) (i < positives ? hits : fas)++;
     result.hitRate = double(hits) / double(positives);
     result.falseAlarm = double(fas) / double(n - positives);
     if (onRound) {
+      RoundInfo info;
+      info.stump = s;
       info.round = round;
       info.hitRate = result.hitRate;
       info.falseAlarm = result.falseAlarm;
@@ -80,33 +66,9 @@ StageResult boostRounds(std::size_t n, std::size_t positives, Fit&& fit, HeldOut
   return result;
 }
 
-}  // namespace
-
-StageResult boostStage(std::size_t n, std::size_t positives, const StumpFinder& find,
-                       const StageConfig& config, const std::function<void(const RoundInfo&)>& onRound,
-                       const HeldOutPositives* heldOut) {
-  std::vector<float> values(n), heldValues(heldOut ? heldOut->count : 0);
-  return boostRounds(
-      n, positives,
-      [&](std::span<const float> weights, std::span<double> outputs, StageResult& result) {
-        const FittedStump s = find(weights, values);
-        for (std::size_t i = 0; i < n; ++i) outputs[i] = s(values[i]);
-        result.stumps.push_back(s);
-        RoundInfo info;
-        info.stump = s;
-        return info;
-      },
-      [&](const StageResult& result, std::span<double> out) {
-        const FittedStump& s = result.stumps.back();
-        heldOut->values(s.feature, heldValues);
-        for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(heldValues[i]);
-      },
-      config, onRound, heldOut);
-}
-
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound, const HeldOutPositives* heldOut) {
+                       const std::function<void(const RoundInfo&)>& onRound) {
   StumpSearchOptions search;
   search.threads = config.threads;
   search.refineTop = config.refineTop;
@@ -117,7 +79,7 @@ StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
         rawValues(s.feature, chosen);
         return s;
       },
-      config, onRound, heldOut);
+      config, onRound);
 }
 
 }  // namespace fusedet::boosting

@@ -99,7 +99,6 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
-  if (c.minHeight > 0) o << "  \"min_height\": " << c.minHeight << ",\n";  // optional: older files lack it
   if (!info.empty()) {
     Json t = Json::object();
     for (const auto& [k, v] : info) t[k] = v;
@@ -167,7 +166,12 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   }
   const Json& hue = r.field(root, "", "reference_hue");
   if (!hue.is_null()) c.referenceHue = r.number(root, "", "reference_hue");
-  if (root.contains("min_height")) c.minHeight = r.integer(root, "", "min_height", 0, 1 << 16);
+  // Written by --min-height-from-positives, removed (a tie cross-drive): such a model would now scan
+  // from its base window, so it is refused rather than run differently without a word.
+  if (root.contains("min_height"))
+    r.fail("min_height", "a model's own minimum detection height (train --min-height-from-positives) is no longer "
+                         "supported; retrain the model with `fusedet train`, or delete the field to scan from the "
+                         "base window");
   const Json& stages = r.array(root, "", "stages");
   if (stages.empty()) r.fail("stages", "no stages");
   std::vector<std::pair<Feature, int>> seen;  // features in first-use order (shared by stumps)

@@ -500,9 +500,7 @@ void setQuickStumpDecisions(bool enabled) { gQuickDecisions = enabled; }
 
 std::vector<ScaleWindows> windowScales(const Cascade& c, int W, int H, const ScanParams& params) {
   if (!(params.scaleFactor > 1)) throw std::invalid_argument("scale factor must be > 1");
-  // The model's own minimum detection height applies unless the caller asks for a minimum size.
-  ScanParams p = params;
-  if (p.minWidth <= 0 && p.minHeight <= 0 && c.minHeight > 0) p.minHeight = c.minHeight;
+  const ScanParams& p = params;
   const int maxW = p.maxWidth > 0 ? std::min(p.maxWidth, W) : W;
   const int maxH = p.maxHeight > 0 ? std::min(p.maxHeight, H) : H;
   double s0 = 1.0;

@@ -44,7 +44,6 @@ TEST(ExperimentPlan, BundledTrainsLikeTheBundledModels) {
     }
   }
   EXPECT_EQ(p.negatives, 0u);  // the trainer's rule, as `fusedet train` used for the models
-  EXPECT_EQ(p.validationPart, 0);
 }
 
 TEST(ExperimentPlan, BundledIsTheDocsResultsPlan) {

@@ -70,28 +70,17 @@ TEST(ModelIo, RoundTripIsExactAndTextIsStable) {
   EXPECT_NE(text.find("\"type\":\"g\""), std::string::npos);
 }
 
-TEST(ModelIo, MinimumDetectionHeightIsOptional) {
-  // Files without "min_height" (every model before it existed) load with 0 = from the base window,
-  // and such a cascade writes no field, so their text is unchanged.
-  const std::string old = modelToText(sample());
-  EXPECT_EQ(old.find("min_height"), std::string::npos);
-  EXPECT_EQ(modelFromText(old, "m.json").minHeight, 0);
-  Cascade c = sample();
-  c.minHeight = 27;
-  const std::string text = modelToText(c);
-  EXPECT_NE(text.find("\"min_height\": 27,"), std::string::npos);
-  EXPECT_EQ(modelFromText(text, "m.json").minHeight, 27);
-  EXPECT_EQ(modelToText(modelFromText(text, "m.json")), text);
-  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": -3")).find("m.json: min_height: -3 out of range"),
-            std::string::npos);
-  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": 2.5")).find("min_height: expected an integer"),
-            std::string::npos);
-  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": \"27\"")).find("min_height: expected an integer"),
-            std::string::npos);
-  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": 99999999999")).find("min_height"),
-            std::string::npos);
-  EXPECT_NE(errorOf(replace(text, "\"min_height\": 27", "\"min_height\": null")).find("min_height"),
-            std::string::npos);
+TEST(ModelIo, RemovedMinimumDetectionHeightIsRefusedWithWhatToDo) {
+  // No model writes "min_height" any more; a file holding it (train --min-height-from-positives,
+  // removed) would scan differently now, so it is refused, naming the field and what to do.
+  const std::string text = modelToText(sample());
+  EXPECT_EQ(text.find("min_height"), std::string::npos);
+  const std::string old = replace(text, "\"layers\":", "\"min_height\": 27,\n  \"layers\":");
+  ASSERT_NE(old, text);
+  const std::string e = errorOf(old);
+  EXPECT_NE(e.find("m.json: min_height: "), std::string::npos) << e;
+  EXPECT_NE(e.find("--min-height-from-positives"), std::string::npos) << e;
+  EXPECT_NE(e.find("retrain the model with `fusedet train`"), std::string::npos) << e;
 }
 
 TEST(ModelIo, SaveAndLoadFile) {
@@ -218,9 +207,7 @@ TEST(ModelIo, ErrorsNameThePlaceAndTheReason) {
 }
 
 TEST(ModelIo, FuzzedFilesNeverCrash) {
-  Cascade withMin = sample();
-  withMin.minHeight = 31;  // the optional field is fuzzed too
-  const std::string good = modelToText(withMin);
+  const std::string good = modelToText(sample());
   std::mt19937 rng(11);
   int loaded = 0, rejected = 0;
   for (int it = 0; it < 3000; ++it) {

@@ -35,23 +35,11 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " refine " << c.stage.refineTop << "\ncascade target_fa " << c.targetFalseAlarm << " max_stages "
     << c.maxStages << " negatives " << c.negativesPerStage << " min_negatives " << c.minNegatives
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
-  if (c.minHeightFromPositives) d << "min_height_from_positives\n";
   // Only when set: keys of configurations without them stay as they were.
   if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";
   if (c.samples.jitterCopies > 0)
     d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
       << c.samples.jitterSeed << "\n";
-  if (c.validation.part > 0) {  // only then: keys of configurations without one stay as they were
-    const ValidationConfig& v = c.validation;
-    d << "validation part " << v.part << " min_hit " << v.minHit << " min_positives " << v.minPositives << " max_cascade_fa "
-      << v.maxCascadeFalseAlarm << " scan " << v.detection.scan.scaleFactor << " " << v.detection.scan.step << " "
-      << v.detection.scan.minWidth << " " << v.detection.scan.minHeight << " group "
-      << v.detection.group.minNeighbors << " " << v.detection.group.eps;
-    d << " match " << v.match.className << " "
-      << v.match.minIou << " " << v.match.minHeight << " " << v.match.maxOcclusion << " " << v.match.maxTruncation
-      << " " << v.match.minDetectionHeight << " aliases " << joined(v.match.aliasClasses) << " neighbours "
-      << joined(v.match.neighbourClasses) << " ignore " << joined(v.match.ignoreClasses) << "\n";
-  }
   return d.str();
 }
 

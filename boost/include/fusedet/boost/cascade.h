@@ -69,9 +69,6 @@ struct HaarFeature {
 struct Cascade {
   std::string className;                // "car", "person", ... or the imported file's stem
   int windowWidth = 24, windowHeight = 24;  // base window in pixels (aspect ratio = w / h)
-  // Smallest object height (reference pixels) the class is looked for at, e.g. its smallest
-  // training positive; 0 = from the base window up. Used unless ScanParams sets a minimum size.
-  int minHeight = 0;
   std::vector<std::string> layers;          // layer names the features index
   std::optional<double> referenceHue;       // degrees, for a "hue_distance" layer
   Normalization normalization = Normalization::kNone;

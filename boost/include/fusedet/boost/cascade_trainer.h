@@ -25,7 +25,6 @@
 #include "fusedet/boost/feature_pool.h"
 #include "fusedet/boost/gentle_boost.h"
 #include "fusedet/boost/training_set.h"
-#include "fusedet/boost/validation_part.h"
 #include "fusedet/core/dataset.h"
 
 namespace fusedet::boosting {
@@ -47,12 +46,6 @@ struct TrainingConfig {
   // whole cascade (TrainingStacks::harvestNegatives()). Same negatives, same model either way;
   // false is the reference path the tests compare with.
   bool incrementalMining = true;
-  // Held-back validation part (validation_part.h): stage thresholds from its positives, the
-  // stage count by F on its frames. Off by default (part 0); in-process training only.
-  ValidationConfig validation;
-  // Store the smallest training positive's height as the model's minimum detection height
-  // (Cascade::minHeight). Off by default: on 3 drive-disjoint car folds it was a tie (issue 15 notes).
-  bool minHeightFromPositives = false;
   // The pool's values on every positive are evaluated once per training and kept (pool x
   // positives floats, sample_features.h) when they take at most this many bytes; above that
   // they are evaluated again each stage. Same values either way.
@@ -75,29 +68,18 @@ struct StageReport {
   // Where the time went: bootstrapping scan, pool evaluation + binning, boosting rounds.
   double harvestSeconds = 0, matrixSeconds = 0, boostSeconds = 0;
   std::size_t matrixBytes = 0;  // the stage's 8-bit feature matrix (pool x samples)
-  // Threshold kept, and the one the training positives gave; with a validation part the kept one
-  // comes from the validationPositives held-back positives that reached this stage
-  // (ValidationConfig::minPositives needed, else the training threshold stays).
-  double threshold = 0, trainingThreshold = 0;
-  std::size_t validationPositives = 0;
 };
 
 struct TrainingReport {
   std::size_t poolSize = 0;
   std::size_t positives = 0;  // incl. mirrored copies
   int windowWidth = 0, windowHeight = 0;
-  int minHeight = 0;  // the smallest training positive's height, floored (Cascade::minHeight when stored)
+  int minHeight = 0;  // the smallest training positive's height, floored
   std::optional<double> referenceHue;
   std::vector<StageReport> stages;
   double finalFalseAlarm = 1;  // of the label-free windows, after the last stage
   std::string stopReason;      // e.g. "reached the target false-alarm rate: 8.1e-06 <= 1e-05"
   double seconds = 0;
-  // Validation part (TrainingConfig::validation): held-back items and positives (incl. mirrored
-  // copies), F / AP per stage count tried, and the stage count kept (= stages.size() when off or
-  // when no count had a positive F). stages[] keep the report of every trained stage.
-  std::size_t validationItems = 0, validationPositives = 0;
-  std::vector<StageCountScore> stageCountScores;
-  std::size_t keptStages = 0;
 };
 
 enum class ProgressKind { kStart, kStageStart, kNegatives, kRound, kStageDone, kFinished };

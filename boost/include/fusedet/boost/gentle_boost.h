@@ -33,21 +33,8 @@ struct RoundInfo {
 struct StageResult {
   std::vector<FittedStump> stumps;  // feature = row of the matrix
   double threshold = 0;             // stage passes when sum of stump outputs >= threshold
-  double trainingThreshold = 0;     // the one the training positives alone give (== threshold without held-out)
   double hitRate = 0, falseAlarm = 0;  // on the training samples, at `threshold`
   bool reachedFalseAlarm = false;   // false: stopped at maxWeak
-};
-
-// Positives held out of a stage's training (the trainer's validation part, validation_part.h):
-// not weighted, not fitted; when given, the stage threshold after every round keeps their minHit of
-// THEM (their sums are not optimistic), and the stage goes on until the false-alarm rate of the
-// negatives at that threshold is <= maxFalseAlarm (Viola & Jones 2001 place the threshold on a
-// validation set the same way).
-struct HeldOutPositives {
-  std::size_t count = 0;
-  double minHit = 0.98;  // share of them every stage keeps
-  // Values of a matrix row's feature on each of them (as float, like the matrix's raw values).
-  std::function<void(std::size_t feature, std::span<float> out)> values;
 };
 
 // One round's weak learner for boostStage(): the best stump for the sample weights (float, sample
@@ -58,15 +45,13 @@ using StumpFinder = std::function<FittedStump(std::span<const float> weights, st
 // finder: trainStage() searches one in-process matrix, sharded_stage.h one sharded over ranks.
 StageResult boostStage(std::size_t samples, std::size_t positives, const StumpFinder& find,
                        const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound = {},
-                       const HeldOutPositives* heldOut = nullptr);
+                       const std::function<void(const RoundInfo&)>& onRound = {});
 
 // Samples [0, positives) of `m` are positives. rawValues gives the raw values of a matrix row
 // (exact refinement and the update use them). onRound (optional) sees every round.
 StageResult trainStage(const FeatureMatrix& m, std::size_t positives,
                        const FeatureValuesFn& rawValues, const StageConfig& config,
-                       const std::function<void(const RoundInfo&)>& onRound = {},
-                       const HeldOutPositives* heldOut = nullptr);
+                       const std::function<void(const RoundInfo&)>& onRound = {});
 
 // Stage threshold for scores of the positives: the largest t with
 // |{s >= t}| >= ceil(minHit * n), nudged down by a relative 1e-9 so the detector's sums, added

@@ -33,7 +33,6 @@ struct ExperimentPlan {
   double targetFalseAlarm = 1e-5;
   std::size_t negatives = 0;  // 0 = the trainer's rule, max(500, 2 x positives)
   double trainScaleFactor = 1.2, trainStep = 3;
-  int validationPart = 0;  // 0 = off (validation_part.h)
   // Detection on the test frames; with classDetection a class that has its own settings
   // (class_detection.h: car) is detected with those instead.
   double scaleFactor = 1.2, step = 3;
