@@ -85,7 +85,6 @@ struct ExperimentOptions {
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
   std::size_t minPositives = 4;
-  int jitter = 0;                                  // jittered copies per positive (training_set.h)
   double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
@@ -327,7 +326,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.minPositives = o.minPositives;
   c.seed = o.seed;
   c.threads = o.threads;
-  c.samples.jitterCopies = o.jitter;
   return c;
 }
 
@@ -559,7 +557,6 @@ int runExperiments(ExperimentOptions o) {
                                          : "the devkit's: car " + shortNum(boosting::kittiMinOverlap("car")) +
                                                ", person and bike " + shortNum(boosting::kittiMinOverlap("person"))},
       {"fold model cache", cache.string()},
-      {"jittered copies per positive", std::to_string(o.jitter)},
   };
   if (!o.classStages.empty()) {
     std::string kept;
@@ -1090,11 +1087,6 @@ const bool registered = registerCommand(
                      "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
                      "longer stages whose sums average more stumps")
           ->check(CLI::Range(1e-6, 0.99))
-          ->capture_default_str();
-      app.add_option("--jitter", o->jitter,
-                     "jittered copies (shifted and scaled by up to 5 %) of every training positive, besides its "
-                     "mirror image, as `fusedet train --jitter` (default: 0)")
-          ->check(CLI::Range(0, 20))
           ->capture_default_str();
       app.add_option("--class-stages", o->classStagesText,
              "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "

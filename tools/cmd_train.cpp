@@ -43,7 +43,6 @@ struct TrainOptions {
   std::size_t negatives = 0;
   double minHeight = 25;
   int maxOcclusion = 1;
-  int jitter = 0;
   double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -201,7 +200,6 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.samples.baseWindowHeight = o.windowHeight;
   c.samples.minPositiveHeight = o.minHeight;
   c.samples.maxOcclusion = o.maxOcclusion;
-  c.samples.jitterCopies = o.jitter;
   c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
   c.samples.scan.scaleFactor = o.scaleFactor;
   c.samples.scan.step = o.step;
@@ -347,10 +345,6 @@ const bool registered = registerCommand(
       app.add_option("--min-height", o->minHeight, "[px] smaller labels of the class are not used as positives")
           ->capture_default_str();
       app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
-          ->capture_default_str();
-      app.add_option("--jitter", o->jitter,
-                     "jittered copies per positive (and per mirrored copy): shifted by up to 5 % of the box, "
-                     "scaled by up to +-5 %")
           ->capture_default_str();
       app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
           ->capture_default_str();

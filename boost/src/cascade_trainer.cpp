@@ -45,9 +45,6 @@ void TrainingConfig::validate() const {
   if (stage.maxWeak < 1) bad("rounds per stage must be >= 1");
   if (!(targetFalseAlarm > 0 && targetFalseAlarm < 1)) bad("target false-alarm rate must be in (0, 1)");
   if (maxStages < 1) bad("stage limit must be >= 1");
-  if (samples.jitterCopies < 0) bad("jittered copies must be >= 0");
-  if (!(samples.jitterShift >= 0 && samples.jitterShift < 0.5)) bad("jitter shift must be in [0, 0.5)");
-  if (!(samples.jitterScale >= 0 && samples.jitterScale < 0.5)) bad("jitter scale must be in [0, 0.5)");
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
   if (!(samples.scan.scaleFactor > 1)) bad("scan scale factor must be > 1");
   if (!(samples.scan.step > 0)) bad("scan step must be > 0");

@@ -47,19 +47,6 @@ bool isNegativeWindow(const Box& window, const Labels& labels, const SampleConfi
   return NegativeWindowTest(labels, c)(window);
 }
 
-std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double scale, std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  std::vector<Box> out;
-  for (int i = 0; i < copies; ++i) {
-    // Draw order fixed (scale, dx, dy) so that the copies are the same on every platform's libstdc++.
-    const double s = 1.0 + scale * unit(rng);
-    const double dx = shift * box.w * unit(rng), dy = shift * box.h * unit(rng);
-    const double w = box.w * s, h = box.h * s;
-    out.push_back(Box{box.x + box.w / 2 + dx - w / 2, box.y + box.h / 2 + dy - h / 2, w, h});
-  }
-  return out;
-}
-
 Labels flippedLabels(const DatasetItem& item) {
   Labels out = item.labels;
   for (Label& l : out) l.box.x = item.stack.width() - l.box.x - l.box.w;
@@ -91,7 +78,7 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                                int threads)
     : config_(config), shard_(shard) {
   // Stacks: the items, then mirrored copies of the items holding positives. Labels, owners and
-  // positives (with the jitter draws) in that order, serially; the integrals in parallel.
+  // positives in that order, serially; the integrals in parallel.
   std::vector<std::pair<std::size_t, bool>> source;  // item index, mirrored
   for (std::size_t i = 0; i < items.size(); ++i) source.emplace_back(i, false);
   originals_ = items.size();
@@ -99,19 +86,13 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
     if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
                     [&](const Label& l) { return isPositiveLabel(l, config_); }))
       source.emplace_back(i, true);
-  std::mt19937_64 rng(config_.jitterSeed);
   for (std::size_t k = 0; k < source.size(); ++k) {
     const auto [i, mirrored] = source[k];
     owner_.push_back(static_cast<int>(i % static_cast<std::size_t>(shard_.ranks)));
     Labels labels = items[i].labels;
     if (mirrored) labels = flippedLabels(items[i]);
     for (const Label& l : labels)
-      if (isPositiveLabel(l, config_)) {
-        positives_.push_back(Sample{static_cast<std::uint32_t>(k), l.box});
-        // Windows reaching over the border are clamped into the layer, as the labels' own are.
-        for (const Box& b : jitteredBoxes(l.box, config_.jitterCopies, config_.jitterShift, config_.jitterScale, rng))
-          positives_.push_back(Sample{static_cast<std::uint32_t>(k), b});
-      }
+      if (isPositiveLabel(l, config_)) positives_.push_back(Sample{static_cast<std::uint32_t>(k), l.box});
     labels_.push_back(std::move(labels));
   }
   integrals_.resize(source.size());

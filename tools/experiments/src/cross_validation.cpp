@@ -37,9 +37,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   // Only when set: keys of configurations without them stay as they were.
   if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";
-  if (c.samples.jitterCopies > 0)
-    d << "jitter " << c.samples.jitterCopies << " " << c.samples.jitterShift << " " << c.samples.jitterScale << " "
-      << c.samples.jitterSeed << "\n";
   return d.str();
 }
 

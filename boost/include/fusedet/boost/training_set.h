@@ -11,7 +11,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -27,13 +26,6 @@ struct SampleConfig {
   // Labels of the class that become positives (KITTI "moderate" by default).
   double minPositiveHeight = 25;  // reference pixels
   int maxOcclusion = 1;
-  // Jittered copies of every positive (and of its mirrored copy): the box shifted by up to
-  // jitterShift of its width/height and scaled by up to 1 +- jitterScale, drawn with jitterSeed.
-  // They teach the small misalignments the detector's scan grid and the labels have.
-  int jitterCopies = 0;
-  double jitterShift = 0.05;
-  double jitterScale = 0.05;
-  std::uint64_t jitterSeed = 7;
   // A window is a negative candidate when IoU < maxNegativeIou with every positive of the class
   // and it overlaps no ignored label by more than maxIgnoreCoverage of the window's area or of the
   // label's area. Ignored labels: ignore regions (DontCare, ...), labels of the class that are not
@@ -136,8 +128,6 @@ class TrainingStacks {
   Shard shard_;
 };
 
-// `copies` jittered versions of `box` (SampleConfig's jitter rule), drawn from `rng`.
-std::vector<Box> jitteredBoxes(const Box& box, int copies, double shift, double scale, std::mt19937_64& rng);
 
 // Horizontally mirrored copy of a stack (every layer and mask) and its labels.
 DatasetItem flipItem(const DatasetItem& item);
