@@ -143,31 +143,6 @@ TEST(Detector, MinAndMaxSizeLimitTheWindows) {
   }
 }
 
-TEST(Detector, ModelsOwnMinimumHeightUnlessTheScanSetsOne) {
-  Cascade c = randomCascade(5);
-  const LayerStack s = randomStack(6);
-  ScanParams p;
-  p.step = 1;
-  ScanStats all, own, overridden;
-  const auto fromBase = Detector(c).scan(s, p, &all);
-  c.minHeight = 40;  // e.g. the class's smallest training positive
-  const auto hits = Detector(c).scan(s, p, &own);
-  EXPECT_LT(own.windows, all.windows);
-  EXPECT_LT(own.scales, all.scales);
-  ASSERT_FALSE(hits.empty());
-  double lowest = 1e9;
-  for (const RawHit& h : hits) lowest = std::min(lowest, h.box.h);
-  EXPECT_EQ(lowest, 40);  // the first scale is the minimum itself (window 16x24 x 40/24)
-  // A minimum size in the scan parameters (the daemon's detection.min_size) wins: 24 = the base
-  // window, so exactly the windows of a model without minimum.
-  p.minHeight = 24;
-  const auto again = Detector(c).scan(s, p, &overridden);
-  EXPECT_EQ(overridden.windows, all.windows);
-  EXPECT_EQ(again.size(), fromBase.size());
-  c.minHeight = -1;
-  EXPECT_THROW(c.validate(), std::invalid_argument);
-}
-
 TEST(Cascade, ValidateNamesTheSourceAndTheProblem) {
   Cascade c = randomCascade(7);
   c.source = "my.model";
