@@ -13,6 +13,7 @@ namespace {
 struct QueryOptions {
   std::string socket = "/run/fusedet/fusedet.sock";
   bool follow = false;
+  bool tracks = false;   // follow the tracks stream instead of detections
   std::vector<std::string> classes;
   bool status = false;
   bool hello = false;
@@ -52,7 +53,23 @@ void printText(const nlohmann::json& m) {
                 b.size() == 4 ? b[3].get<double>() : 0.0, vec3(d.value("camera", nlohmann::json())).c_str(),
                 vec3(d.value("robot", nlohmann::json())).c_str(),
                 metres(d.value("range", nlohmann::json())).c_str());
+    if (d.value("track", nlohmann::json()).is_number())
+      std::printf("          track %s%s  velocity %s/s  age %.1f s\n", d["track"].dump().c_str(),
+                  d.value("confirmed", false) ? "" : " (tentative)", vec3(d.value("velocity", nlohmann::json())).c_str(),
+                  d.value("age", 0.0));
   }
+}
+
+// One stack's live tracks for a person to read.
+void printTracksText(const nlohmann::json& m) {
+  std::printf("stack %s  frame %.3f s  %zu tracks\n", m.value("stack", nlohmann::json()).dump().c_str(),
+              m.value("frame_ns", std::int64_t{0}) * 1e-9, m.value("tracks", nlohmann::json::array()).size());
+  for (const auto& t : m.value("tracks", nlohmann::json::array()))
+    std::printf("  track %-5s %-7s %-9s %-8s robot %s  velocity %s/s  age %.1f s  hits %d  misses %d\n",
+                t.value("id", nlohmann::json()).dump().c_str(), t.value("class", "?").c_str(),
+                t.value("confirmed", false) ? "confirmed" : "tentative", t.value("coasting", false) ? "coasting" : "",
+                vec3(t.value("robot", nlohmann::json())).c_str(), vec3(t.value("velocity", nlohmann::json())).c_str(),
+                t.value("age", 0.0), t.value("hits", 0), t.value("misses", 0));
 }
 
 int runQuery(const QueryOptions& o) {
@@ -68,12 +85,15 @@ int runQuery(const QueryOptions& o) {
     auto message = nlohmann::json::parse(*line, nullptr, false);
     if (o.text && message.is_object() && message.value("type", "") == "detections")
       printText(message);
+    else if (o.text && message.is_object() && message.value("type", "") == "tracks")
+      printTracksText(message);
     else
       std::printf("%s\n", line->c_str());
     std::fflush(stdout);
     return message;
   };
-  if (o.hello || o.follow) {
+  const bool follow = o.follow || o.tracks;
+  if (o.hello || follow) {
     client.send({{"cmd", "hello"}});
     if (!printNext()) return 1;
   }
@@ -81,19 +101,21 @@ int runQuery(const QueryOptions& o) {
     client.send({{"cmd", "status"}});
     return printNext() ? 0 : 1;
   }
-  if (!o.follow) {
+  if (!follow) {
     if (o.hello) return 0;
     client.send({{"cmd", "latest"}});
     return printNext() ? 0 : 1;
   }
   nlohmann::json request{{"cmd", "subscribe"}};
   if (!o.classes.empty()) request["classes"] = o.classes;
+  if (o.tracks) request["stream"] = "tracks";
   client.send(request);
+  const std::string counted = o.tracks ? "tracks" : "detections";
   for (long seen = 0; o.count == 0 || seen < o.count;) {
     auto message = printNext();
     if (!message) return 1;
     if (message->is_object() && message->value("type", "") == "error") return 1;
-    if (message->is_object() && message->value("type", "") == "detections") ++seen;
+    if (message->is_object() && message->value("type", "") == counted) ++seen;
   }
   return 0;
 }
@@ -103,8 +125,10 @@ const bool registered = registerCommand(
       auto o = std::make_shared<QueryOptions>();
       app.add_option("-s,--socket", o->socket, "the daemon's socket")->capture_default_str();
       app.add_flag("-f,--follow", o->follow, "subscribe and print every stack's detections as they come");
+      app.add_flag("--tracks", o->tracks,
+                   "subscribe to the tracks stream: one line per stack with every live track (implies --follow)");
       app.add_option("-c,--class", o->classes, "with --follow: only these classes (repeat for several)");
-      app.add_option("-n,--count", o->count, "with --follow: stop after this many detection lines (0 = never)")
+      app.add_option("-n,--count", o->count, "with --follow: stop after this many detections (or tracks) lines (0 = never)")
           ->capture_default_str();
       app.add_flag("--text", o->text, "print detections as readable text (one line per stack and per detection)");
       app.add_flag("--status", o->status, "print the daemon's status (sensors, rates, drops, latency)");
@@ -117,12 +141,15 @@ const bool registered = registerCommand(
           "classes was found) until --count lines, the daemon closing, or --timeout without a line.\n"
           "--text prints each detections line as text instead: the stack's stamps (CLOCK_MONOTONIC\n"
           "seconds) and sensor->detected time, then per detection class, score, box (pixels), camera\n"
-          "and robot frame position and range (metres; - when the box has too few laser cells).\n\n"
+          "and robot frame position and range (metres; - when the box has too few laser cells), and its\n"
+          "track (id, velocity, age). --tracks follows the \"tracks\" stream instead: per stack every live\n"
+          "track (id, class, confirmed or tentative, coasting, robot-frame position and velocity, age).\n\n"
           "Exit status: 0 on success; 1 when the daemon cannot be reached, sends an error line, closes\n"
           "the connection or does not answer in time.\n\n"
           "Examples:\n"
           "  fusedet query --status\n"
           "  fusedet query --follow --class person --class car\n"
+          "  fusedet query --tracks --text\n"
           "  fusedet query --socket /tmp/fusedet.sock --follow --count 5\n"
           "  fusedet query --socket /tmp/fusedet-demo.sock --follow --text");
       return [o] { return runQuery(*o); };

@@ -251,6 +251,20 @@ Config parseTree(const YAML::Node& root, const std::string& source) {
     s.finish();
   }
   {
+    Section s = top.child("tracking");
+    tracking::TrackerParams& t = c.tracking;
+    s.readRange("acceleration_sigma", t.noise.accelerationSigma, 1e-3, 1e3);
+    s.readRange("measurement_sigma", t.noise.measurementSigma, 1e-3, 1e3);
+    s.readRange("initial_velocity_sigma", t.noise.initialVelocitySigma, 1e-3, 1e3);
+    s.readRange("gate", t.gate, 1e-3, 1e6);
+    s.readRange("birth_hits", t.birthHits, 1, 100);
+    s.readRange("birth_window", t.birthWindow, 1, 100);
+    if (t.birthWindow < t.birthHits) s.fail(s.at("birth_window"), "key tracking.birth_window: must be >= tracking.birth_hits");
+    s.readRange("max_misses", t.maxMisses, 0, 1000);
+    s.readRange("max_coast_s", t.maxCoastS, 1e-3, 3600.0);
+    s.finish();
+  }
+  {
     Section s = top.child("replay");
     s.read("file", c.replay.file);
     s.read("realtime", c.replay.realtime);
@@ -389,6 +403,15 @@ std::string dumpConfig(const Config& c) {
     out << YAML::Key << k.name << YAML::Value << YAML::BeginMap << YAML::Key << "min_neighbors" << YAML::Value
         << k.minNeighbors << YAML::Key << "laser_extent" << YAML::Value << k.laserExtent << YAML::EndMap;
   out << YAML::EndMap << YAML::EndMap;
+  out << YAML::Key << "tracking" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "acceleration_sigma" << YAML::Value << c.tracking.noise.accelerationSigma;
+  out << YAML::Key << "measurement_sigma" << YAML::Value << c.tracking.noise.measurementSigma;
+  out << YAML::Key << "initial_velocity_sigma" << YAML::Value << c.tracking.noise.initialVelocitySigma;
+  out << YAML::Key << "gate" << YAML::Value << c.tracking.gate;
+  out << YAML::Key << "birth_hits" << YAML::Value << c.tracking.birthHits;
+  out << YAML::Key << "birth_window" << YAML::Value << c.tracking.birthWindow;
+  out << YAML::Key << "max_misses" << YAML::Value << c.tracking.maxMisses;
+  out << YAML::Key << "max_coast_s" << YAML::Value << c.tracking.maxCoastS << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << c.replay.file;
   out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime;

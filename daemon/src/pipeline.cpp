@@ -19,7 +19,8 @@ Pipeline::Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> det
       sensorQueue_(setup_.sensorQueueCapacity, setup_.sensorQueueBytes, &Pipeline::bytesOf),
       stackQueue_(setup_.stackQueueCapacity),
       assembler_(setup_.sweep),
-      pairer_(setup_.maxPairSkewNs, 32, setup_.pairerBytes) {
+      pairer_(setup_.maxPairSkewNs, 32, setup_.pairerBytes),
+      tracker_(setup_.tracking) {
   if (!setup_.fuser) throw std::invalid_argument("Pipeline: no fuser");
   if (!detector_) throw std::invalid_argument("Pipeline: no detector");
 }
@@ -237,6 +238,8 @@ void Pipeline::detectionLoop() {
     const auto t2 = std::chrono::steady_clock::now();
     result->detectMs = std::chrono::duration<double, std::milli>(t2 - t0).count();
     result->stages.localizeMs = result->detectMs - result->stages.detectMs;
+    track(*result);
+    result->stages.trackMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t2).count();
     result->detectedAt = Stamp::now();
     stackRate_.tick(result->detectedAt.ns);
     const std::size_t found = result->detections.size();
@@ -249,6 +252,21 @@ void Pipeline::detectionLoop() {
     counters_.lastDetectMs = detectMs;
   }
   detectionDone_ = true;
+}
+
+void Pipeline::track(StackResult& result) {
+  std::vector<tracking::Observation> observations;
+  observations.reserve(result.detections.size());
+  for (const LocatedDetection& d : result.detections) {
+    tracking::Observation o;
+    o.className = d.detection.className;
+    if (d.position) o.position = d.position->robot;
+    o.box = d.detection.box;
+    observations.push_back(std::move(o));
+  }
+  tracking::TrackedStack tracked = tracker_.update(result.frameStamp, observations);
+  for (std::size_t i = 0; i < result.detections.size(); ++i) result.detections[i].track = tracked.trackOf[i];
+  result.tracks = std::move(tracked.tracks);
 }
 
 PipelineCounters Pipeline::counters() const {

@@ -37,6 +37,18 @@ std::optional<Request> parseRequest(std::string_view line, std::string& error, n
     error = "unknown cmd '" + c.substr(0, 64) + "'";
     return std::nullopt;
   }
+  if (const auto stream = j.find("stream"); stream != j.end() && !stream->is_null()) {
+    if (r.command != Request::Command::kSubscribe && r.command != Request::Command::kUnsubscribe) {
+      error = "\"stream\" only goes with subscribe and unsubscribe";
+      return std::nullopt;
+    }
+    if (!stream->is_string() || (*stream != "detections" && *stream != "tracks")) {
+      error = "\"stream\" must be \"detections\" or \"tracks\"";
+      return std::nullopt;
+    }
+    r.stream = stream->get<std::string>();
+  }
+  if (r.command == Request::Command::kSubscribe && r.stream.empty()) r.stream = "detections";
   if (const auto classes = j.find("classes"); classes != j.end() && !classes->is_null()) {
     if (r.command != Request::Command::kSubscribe) {
       error = "\"classes\" only goes with subscribe";
@@ -75,6 +87,18 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
       j["robot"] = nullptr;
       j["range"] = nullptr;
     }
+    if (ld.track >= 0) {
+      const tracking::TrackState& t = r.tracks.at(static_cast<std::size_t>(ld.track));
+      j["track"] = t.id;
+      j["velocity"] = vec3(t.velocity);
+      j["age"] = t.ageS;
+      j["confirmed"] = t.confirmed;
+    } else {
+      j["track"] = nullptr;
+      j["velocity"] = nullptr;
+      j["age"] = nullptr;
+      j["confirmed"] = false;
+    }
     dets.push_back(std::move(j));
   }
   return {{"type", type},
@@ -93,8 +117,33 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
                          {"queue", r.stages.queueMs},
                          {"detect", r.stages.detectMs},
                          {"detect_cpu", r.stages.detectCpuMs},
-                         {"localize", r.stages.localizeMs}}},
+                         {"localize", r.stages.localizeMs},
+                         {"track", r.stages.trackMs}}},
           {"detections", std::move(dets)}};
+}
+
+nlohmann::json tracksToJson(const StackResult& r, const std::set<std::string>& classes) {
+  nlohmann::json tracks = nlohmann::json::array();
+  for (const tracking::TrackState& t : r.tracks) {
+    if (!classes.empty() && !classes.count(t.className)) continue;
+    tracks.push_back({{"id", t.id},
+                      {"class", t.className},
+                      {"confirmed", t.confirmed},
+                      {"coasting", t.coasting},
+                      {"robot", vec3(t.position)},
+                      {"velocity", vec3(t.velocity)},
+                      {"sigma", t.positionSigma},
+                      {"age", t.ageS},
+                      {"hits", t.hits},
+                      {"misses", t.misses},
+                      {"box", {t.box.x, t.box.y, t.box.w, t.box.h}}});
+  }
+  return {{"type", "tracks"},
+          {"stack", r.stackId},
+          {"frame_ns", r.frameStamp.ns},
+          {"sensor_ns", r.sensorStamp.ns},
+          {"detected_ns", r.detectedAt.ns},
+          {"tracks", std::move(tracks)}};
 }
 
 std::string toLine(const nlohmann::json& message) {

@@ -56,6 +56,8 @@ struct Server::Client {
   bool writeInterest = false;
   bool subscribed = false;
   std::set<std::string> classes;
+  bool tracksSubscribed = false;
+  std::set<std::string> trackClasses;
 };
 
 namespace {
@@ -427,15 +429,23 @@ void Server::handleLine(Client& c, std::string_view line) {
       reply["type"] = "hello";
       break;
     case Request::Command::kSubscribe:
-      c.subscribed = true;
-      c.classes = request->classes;
+      if (request->stream == "tracks") {
+        c.tracksSubscribed = true;
+        c.trackClasses = request->classes;
+        reply = {{"type", "subscribed"}, {"stream", "tracks"}, {"classes", c.trackClasses}};
+      } else {
+        c.subscribed = true;
+        c.classes = request->classes;
+        reply = {{"type", "subscribed"}, {"classes", c.classes}};
+      }
       updatePeers();
-      reply = {{"type", "subscribed"}, {"classes", c.classes}};
       break;
     case Request::Command::kUnsubscribe:
-      c.subscribed = false;
+      if (request->stream != "tracks") c.subscribed = false;
+      if (request->stream != "detections") c.tracksSubscribed = false;
       updatePeers();
       reply = {{"type", "unsubscribed"}};
+      if (!request->stream.empty()) reply["stream"] = request->stream;
       break;
     case Request::Command::kLatest: {
       std::shared_ptr<const StackResult> latest;
@@ -530,12 +540,19 @@ void Server::dispatch() {
   }
   for (const auto& r : results) {
     // One encoded line per distinct class filter, shared by the clients using it.
-    std::map<std::set<std::string>, std::shared_ptr<const std::string>> lines;
+    std::map<std::set<std::string>, std::shared_ptr<const std::string>> lines, trackLines;
     for (auto& c : clients_) {
-      if (c->dead || !c->subscribed) continue;
-      auto& line = lines[c->classes];
-      if (!line) line = std::make_shared<const std::string>(toLine(resultToJson(*r, c->classes)));
-      queue(*c, line);
+      if (c->dead) continue;
+      if (c->subscribed) {
+        auto& line = lines[c->classes];
+        if (!line) line = std::make_shared<const std::string>(toLine(resultToJson(*r, c->classes)));
+        queue(*c, line);
+      }
+      if (c->tracksSubscribed) {
+        auto& line = trackLines[c->trackClasses];
+        if (!line) line = std::make_shared<const std::string>(toLine(tracksToJson(*r, c->trackClasses)));
+        queue(*c, line);
+      }
     }
     latency_.add(static_cast<double>(Stamp::now() - r->sensorStamp) * 1e-6);
   }

@@ -72,21 +72,26 @@ std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const st
   return std::make_shared<const CascadeSet>(config.detection, configFile.parent_path());
 }
 
+PipelineSetup pipelineSetup(ServiceParts& parts) {
+  const Config& sensors = parts.sensorConfig ? *parts.sensorConfig : parts.config;
+  PipelineSetup setup;
+  setup.fuser = std::move(parts.fuser);
+  setup.sweep = sweepConfig(sensors);
+  setup.maxPairSkewNs = std::int64_t{sensors.fusion.maxPairSkewMs} * 1'000'000;
+  setup.lossless = parts.lossless;
+  setup.tracking = parts.config.tracking;
+  return setup;
+}
+
 Service::Service(ServiceParts parts)
-    : config_(std::move(parts.config)),
+    : config_(parts.config),
       configFile_(std::move(parts.configFile)),
       mode_(std::move(parts.mode)),
       wallClockStamps_(parts.wallClockStamps),
       sources_(std::move(parts.sources)) {
   Server::Handlers handlers{[this] { return hello(); }, [this] { return status(); }};
   server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
-  const Config& sensors = parts.sensorConfig ? *parts.sensorConfig : config_;
-  PipelineSetup setup;
-  setup.fuser = std::move(parts.fuser);
-  setup.sweep = sweepConfig(sensors);
-  setup.maxPairSkewNs = std::int64_t{sensors.fusion.maxPairSkewMs} * 1'000'000;
-  setup.lossless = parts.lossless;
-  pipeline_ = std::make_unique<Pipeline>(std::move(setup), std::move(parts.detector),
+  pipeline_ = std::make_unique<Pipeline>(pipelineSetup(parts), std::move(parts.detector),
                                          [this](std::shared_ptr<const StackResult> r) { server_->publish(std::move(r)); });
 }
 

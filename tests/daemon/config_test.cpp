@@ -140,3 +140,23 @@ TEST(Config, InstalledConfigFileFollowsThePrefixAndTheFhsRuleForUsr) {
   EXPECT_EQ(installedConfigFile("/usr/local/bin/fusedetd"), "/usr/local/etc/fusedet/fusedet.yaml");
   EXPECT_EQ(installedConfigFile("/opt/robot/bin/fusedetd"), "/opt/robot/etc/fusedet/fusedet.yaml");
 }
+
+TEST(Config, TrackingKeysRoundTripAndAreChecked) {
+  const Config c = parseConfig("tracking:\n  gate: 9.0\n  birth_hits: 3\n  birth_window: 5\n  max_misses: 1\n  max_coast_s: 0.5\n"
+                               "  acceleration_sigma: 1.5\n  measurement_sigma: 0.3\n  initial_velocity_sigma: 4\n",
+                               "t.yaml");
+  EXPECT_EQ(c.tracking.gate, 9.0);
+  EXPECT_EQ(c.tracking.birthHits, 3);
+  EXPECT_EQ(c.tracking.birthWindow, 5);
+  EXPECT_EQ(c.tracking.maxMisses, 1);
+  EXPECT_EQ(c.tracking.maxCoastS, 0.5);
+  EXPECT_EQ(c.tracking.noise.accelerationSigma, 1.5);
+  EXPECT_EQ(c.tracking.noise.measurementSigma, 0.3);
+  EXPECT_EQ(c.tracking.noise.initialVelocitySigma, 4.0);
+  const Config back = parseConfig(dumpConfig(c), "dump.yaml");
+  EXPECT_EQ(dumpConfig(back), dumpConfig(c));
+  EXPECT_EQ(errorOf("tracking:\n  birth_hits: 4\n  birth_window: 3\n"),
+            "test.yaml:3: key tracking.birth_window: must be >= tracking.birth_hits");
+  EXPECT_EQ(errorOf("tracking:\n  gates: 3\n"), "test.yaml:2: unknown key tracking.gates");
+  EXPECT_EQ(errorOf("tracking:\n  gate: -1\n"), "test.yaml:2: key tracking.gate: -1 is outside [0.001, 1e+06]");
+}

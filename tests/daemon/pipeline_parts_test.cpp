@@ -147,6 +147,53 @@ TEST(Protocol, ResultLineFiltersClassesAndCarriesStampsAndPositions) {
   EXPECT_EQ(errorLine("x", 5), "{\"error\":\"x\",\"id\":5,\"type\":\"error\"}\n");
 }
 
+TEST(Protocol, TrackFieldsAndTheTracksStream) {
+  std::string err;
+  auto r = parseRequest(R"({"cmd":"subscribe","stream":"tracks","classes":["car"]})", err);
+  ASSERT_TRUE(r) << err;
+  EXPECT_EQ(r->stream, "tracks");
+  EXPECT_EQ(parseRequest(R"({"cmd":"subscribe"})", err)->stream, "detections");
+  EXPECT_EQ(parseRequest(R"({"cmd":"unsubscribe"})", err)->stream, "");
+  EXPECT_EQ(parseRequest(R"({"cmd":"unsubscribe","stream":"tracks"})", err)->stream, "tracks");
+  EXPECT_FALSE(parseRequest(R"({"cmd":"subscribe","stream":"everything"})", err));
+  EXPECT_NE(err.find("stream"), std::string::npos) << err;
+  EXPECT_FALSE(parseRequest(R"({"cmd":"status","stream":"tracks"})", err));
+
+  StackResult s;
+  s.stackId = 9;
+  s.frameStamp = Stamp{500};
+  LocatedDetection tracked, untracked;
+  tracked.detection.className = "car";
+  tracked.track = 0;
+  untracked.detection.className = "person";
+  s.detections = {tracked, untracked};
+  tracking::TrackState car, person;
+  car.id = 7;
+  car.className = "car";
+  car.confirmed = true;
+  car.velocity = {1.5, -0.5, 0};
+  car.ageS = 2.5;
+  person.id = 8;
+  person.className = "person";
+  person.coasting = true;
+  s.tracks = {car, person};
+  const auto line = resultToJson(s);
+  EXPECT_EQ(line["detections"][0]["track"], 7);
+  EXPECT_EQ(line["detections"][0]["velocity"], nlohmann::json({1.5, -0.5, 0}));
+  EXPECT_EQ(line["detections"][0]["age"], 2.5);
+  EXPECT_EQ(line["detections"][0]["confirmed"], true);
+  EXPECT_TRUE(line["detections"][1]["track"].is_null());
+  EXPECT_EQ(line["detections"][1]["confirmed"], false);
+  const auto tracks = tracksToJson(s);
+  EXPECT_EQ(tracks["type"], "tracks");
+  EXPECT_EQ(tracks["stack"], 9);
+  ASSERT_EQ(tracks["tracks"].size(), 2u);
+  EXPECT_EQ(tracks["tracks"][1]["id"], 8);
+  EXPECT_EQ(tracks["tracks"][1]["coasting"], true);
+  EXPECT_EQ(tracks["tracks"][1]["confirmed"], false);
+  EXPECT_EQ(tracksToJson(s, {"car"})["tracks"].size(), 1u);
+}
+
 TEST(DetectionSettings, ConfigDefaultsAreTheLibraryDefaults) {
   const Config::Detection d;
   const boosting::ScanParams s = scanParamsFrom(d), lib;

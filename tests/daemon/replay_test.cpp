@@ -11,6 +11,8 @@
 #include <thread>
 
 #include "fusedet/daemon/client.h"
+#include "fusedet/daemon/offline_replay.h"
+#include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/replay_source.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/daemon/service.h"
@@ -66,20 +68,26 @@ nlohmann::json content(nlohmann::json line) {
 
 // Subscribes (before the service starts, so nothing is missed), reads every detections line
 // until the replay finished and the queue is drained.
-std::vector<nlohmann::json> replayOnce(const Config& config, nlohmann::json* status = nullptr) {
+// With `tracks`, the client also subscribes to the tracks stream and collects its lines there.
+std::vector<nlohmann::json> replayOnce(const Config& config, nlohmann::json* status = nullptr,
+                                       std::vector<nlohmann::json>* tracks = nullptr) {
   auto service = startReplay(config);
   Client client(config.socket.path);
   client.send({{"cmd", "subscribe"}});
+  if (tracks) client.send({{"cmd", "subscribe"}, {"stream", "tracks"}});
   service->start();
   std::vector<nlohmann::json> lines;
+  auto take = [&](const nlohmann::json& m) {
+    if (m["type"] == "detections") lines.push_back(content(m));
+    if (tracks && m["type"] == "tracks") tracks->push_back(m);
+  };
   const auto end = std::chrono::steady_clock::now() + 300s;
   while (std::chrono::steady_clock::now() < end) {
     auto m = client.read(200ms);
-    if (m && (*m)["type"] == "detections") lines.push_back(content(*m));
+    if (m) take(*m);
     if (!m && service->finished()) break;
   }
-  while (auto m = client.read(500ms))
-    if ((*m)["type"] == "detections") lines.push_back(content(*m));
+  while (auto m = client.read(500ms)) take(*m);
   if (status) *status = service->status();
   service->stop(std::chrono::steady_clock::now() + 1500ms);
   return lines;
@@ -432,4 +440,43 @@ TEST(ReplayService, ALogThatShrinksUnderTheReplayFailsTheSourceNotTheProcess) {
   ASSERT_TRUE(hello);
   EXPECT_EQ((*hello)["type"], "hello");
   service->stop(std::chrono::steady_clock::now() + 1500ms);
+}
+
+// `fusedet replay`'s runner gives exactly the socket's detections lines (timings aside), with
+// track ids that the tracks stream of the same stack lists with the same class and state.
+TEST(ReplayService, OfflineReplayWritesTheSocketsLinesAndTracksAgree) {
+  const fs::path log = testlogs::daemonTestLog(kStrokes);
+  const Config config = replayConfig(tempSocket("offline.sock"), log);
+  std::vector<nlohmann::json> tracks;
+  const auto socket = replayOnce(config, nullptr, &tracks);
+  std::vector<nlohmann::json> offline;
+  const OfflineReplayReport report =
+      replayOffline(config, {}, log, [&](const StackResult& r) { offline.push_back(content(resultToJson(r))); });
+  EXPECT_EQ(report.counters.stacksDetected, static_cast<std::uint64_t>(kStrokes));
+  EXPECT_EQ(report.damage, "");
+  ASSERT_EQ(offline.size(), static_cast<std::size_t>(kStrokes));
+  EXPECT_EQ(offline, socket);
+
+  ASSERT_EQ(tracks.size(), socket.size());
+  std::size_t tracked = 0;
+  for (std::size_t k = 0; k < socket.size(); ++k) {
+    EXPECT_EQ(tracks[k]["stack"], socket[k]["stack"]);
+    std::map<std::uint64_t, nlohmann::json> live;
+    for (const auto& t : tracks[k]["tracks"]) live[t["id"].get<std::uint64_t>()] = t;
+    for (const auto& d : socket[k]["detections"]) {
+      if (d["robot"].is_null()) {
+        EXPECT_TRUE(d["track"].is_null()) << "no position, no track";
+        continue;
+      }
+      ++tracked;
+      ASSERT_TRUE(d["track"].is_number()) << d.dump();
+      const auto it = live.find(d["track"].get<std::uint64_t>());
+      ASSERT_NE(it, live.end()) << "track of a detection missing from the tracks line";
+      EXPECT_EQ(it->second["class"], d["class"]);
+      EXPECT_EQ(it->second["confirmed"], d["confirmed"]);
+      EXPECT_EQ(it->second["coasting"], false);
+      EXPECT_EQ(it->second["velocity"], d["velocity"]);
+    }
+  }
+  EXPECT_GT(tracked, 0u) << "the test log's detections have laser positions";
 }

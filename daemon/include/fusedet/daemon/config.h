@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "fusedet/tracking/tracker.h"
+
 namespace fusedet::daemon {
 
 class ConfigError : public std::runtime_error {
@@ -100,6 +102,9 @@ struct Config {
     static std::vector<ClassSettings> builtInClasses();
     std::vector<ClassSettings> classes = builtInClasses();
   } detection;
+
+  // The tracker after detection (section `tracking`); its defaults are the library's.
+  tracking::TrackerParams tracking;
 
   struct Replay {
     std::string file;         // MCAP sensor log; non-empty = replay mode (relative: to the config's folder)

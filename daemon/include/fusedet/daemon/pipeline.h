@@ -1,6 +1,6 @@
 #pragma once
 // Pipeline: sensor messages -> sweep assembly -> pairing -> fusion (fusion thread) -> every class
-// (detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
+// (detection thread) -> 3D positions -> tracks (tracking::Tracker, detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
 // own threads and push into the sensor queue through the SensorSink interface; both queues are
 // bounded (the sensor queue by count and bytes) and drop their oldest item when full (counted), so no producer ever waits. When
 // detection falls behind, the stack queue (2 deep) drops the oldest stack. Lossless mode (a log
@@ -27,12 +27,14 @@
 #include "fusedet/fusion/fuser.h"
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
+#include "fusedet/tracking/tracker.h"
 
 namespace fusedet::daemon {
 
 struct LocatedDetection {
   Detection detection;               // detection.position = the robot-frame position, if any
   std::optional<Position> position;  // camera and robot frame, range, cells used
+  int track = -1;                    // index into StackResult::tracks; -1 = not tracked (no position)
 };
 
 // Where one stack's time went, in milliseconds: wall time, and the thread's own CPU time where
@@ -48,6 +50,7 @@ struct StageTimes {
   double detectMs = 0;     // every class: integrals, window scan, grouping
   double detectCpuMs = 0;  // the detection thread's CPU time for it (helper threads not counted)
   double localizeMs = 0;   // 3D positions of the detections
+  double trackMs = 0;      // the tracker's update (tracking::Tracker)
 };
 
 // Everything the detection thread found in one stack.
@@ -60,6 +63,8 @@ struct StackResult {
   double fuseMs = 0, detectMs = 0;  // detectMs: detection + localisation
   StageTimes stages;
   std::vector<LocatedDetection> detections;
+  // Every live track after this stack (tentative, confirmed, coasting), ascending id.
+  std::vector<tracking::TrackState> tracks;
 };
 
 struct PipelineSetup {
@@ -73,6 +78,7 @@ struct PipelineSetup {
   // Fusion waits for room in the stack queue instead of dropping the oldest stack. Only for
   // sources that can wait too (a log replayed as fast as possible), never for live devices.
   bool lossless = false;
+  tracking::TrackerParams tracking;  // the tracker after detection (config `tracking`)
 };
 
 struct PipelineCounters {
@@ -147,6 +153,9 @@ class Pipeline : public SensorSink {
   void detectionLoop();
   void handle(SensorMessage& message);
   void fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFrame& frame);
+  // Runs the tracker on one stack's located detections: sets each detection's track and the
+  // stack's live tracks (stamp: the camera frame's).
+  void track(StackResult& result);
 
   PipelineSetup setup_;
   ResultHandler onResult_;
@@ -158,6 +167,7 @@ class Pipeline : public SensorSink {
   fusion::SweepAssembler assembler_;   // fusion thread only
   fusion::FramePairer pairer_;         // fusion thread only
   std::uint64_t nextStackId_ = 0;      // fusion thread only
+  tracking::Tracker tracker_;          // detection thread only
 
   std::thread fusionThread_, detectionThread_;
   std::atomic<bool> abandon_{false}, detectionDone_{false};

@@ -19,6 +19,9 @@ inline constexpr int kProtocolVersion = 1;
 struct Request {
   enum class Command { kHello, kSubscribe, kUnsubscribe, kLatest, kStatus } command = Command::kHello;
   std::set<std::string> classes;  // subscribe: empty = every class
+  // subscribe / unsubscribe: "detections" (default for subscribe) or "tracks"; unsubscribe
+  // without a stream ends both.
+  std::string stream;
   nlohmann::json id;              // echoed in the reply when present (null = absent)
 };
 
@@ -30,6 +33,10 @@ std::optional<Request> parseRequest(std::string_view line, std::string& error, n
 // {"type":"detections", ...} for one stack; only the detections of `classes` (empty = all).
 nlohmann::json resultToJson(const StackResult& result, const std::set<std::string>& classes = {},
                             const char* type = "detections");
+
+// {"type":"tracks", ...} for one stack: every live track (tentative, confirmed, coasting) of
+// `classes` (empty = all).
+nlohmann::json tracksToJson(const StackResult& result, const std::set<std::string>& classes = {});
 
 // {"type":"error","error":reason} (+ "id" when not null), as a line with its newline.
 std::string errorLine(const std::string& reason, const nlohmann::json& id = nullptr);

@@ -49,6 +49,9 @@ std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusio
 // does not exist on this machine.
 ServerLimits serverLimitsFrom(const Config& config);
 SocketAccess socketAccessFrom(const Config& config);
+// The pipeline the parts ask for: their fuser, sweep assembly and pairing of the sensors' rig
+// (sensorConfig, else config), lossless as set, the tracker of config.tracking. Takes the fuser.
+PipelineSetup pipelineSetup(ServiceParts& parts);
 // Models resolve relative to the config file's folder.
 std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
 

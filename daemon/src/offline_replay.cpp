@@ -1,0 +1,38 @@
+#include "fusedet/daemon/offline_replay.h"
+
+#include <chrono>
+#include <thread>
+
+#include "fusedet/daemon/service_parts.h"
+
+namespace fusedet::daemon {
+
+OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
+                                  const std::filesystem::path& log,
+                                  const std::function<void(const StackResult&)>& onResult) {
+  config.replay.file = std::filesystem::absolute(log).string();
+  config.replay.realtime = false;
+  config.replay.restamp = false;
+  config.replay.atEnd = "exit";
+  ServiceParts parts = replayParts(std::move(config), configFile);
+  Pipeline pipeline(pipelineSetup(parts), parts.detector,
+                    [&onResult](std::shared_ptr<const StackResult> r) { onResult(*r); });
+  pipeline.start();
+  for (auto& s : parts.sources) s->start(pipeline);
+  auto done = [&] {
+    for (const auto& s : parts.sources)
+      if (!s->finished()) return false;
+    return pipeline.idle();
+  };
+  while (!done()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  for (auto& s : parts.sources) s->stop();
+  pipeline.stop(std::chrono::steady_clock::now() + std::chrono::seconds(10));
+  OfflineReplayReport report;
+  report.counters = pipeline.counters();
+  for (const auto& s : parts.sources)
+    for (const SensorHealth& h : s->health())
+      if (!h.lastError.empty()) report.damage += (report.damage.empty() ? "" : "; ") + h.lastError;
+  return report;
+}
+
+}  // namespace fusedet::daemon
