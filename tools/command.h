@@ -16,7 +16,7 @@ using CommandSetup = std::function<CommandRunner(CLI::App& app)>;
 
 struct Command {
   std::string name;
-  std::string description;
+  std::string description;  // one line: `fusedet --help` lists it; the long text goes in the setup's app.description()
   CommandSetup setup;
 };
 

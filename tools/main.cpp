@@ -7,6 +7,8 @@
 #include <iostream>
 #include <algorithm>
 #include <map>
+#include <memory>
+#include <sstream>
 
 #include "command.h"
 
@@ -26,6 +28,26 @@ bool registerCommand(std::string name, std::string description, CommandSetup set
 
 const std::vector<Command>& commands() { return registry(); }
 
+namespace {
+// `fusedet --help` lists each subcommand on one line: its registered description. A command's
+// setup may replace its description with the long explanation; that one shows in `fusedet NAME
+// --help` only.
+class CommandListFormatter : public CLI::Formatter {
+ public:
+  void summary(const CLI::App* sub, std::string text) { summaries_[sub] = std::move(text); }
+  std::string make_subcommand(const CLI::App* sub) const override {
+    const auto it = summaries_.find(sub);
+    if (it == summaries_.end()) return CLI::Formatter::make_subcommand(sub);
+    std::stringstream out;
+    CLI::detail::format_help(out, sub->get_display_name(true), it->second, get_column_width());
+    return out.str();
+  }
+
+ private:
+  std::map<const CLI::App*, std::string> summaries_;
+};
+}  // namespace
+
 }  // namespace fusedet::tools
 
 int main(int argc, char** argv) {
@@ -43,10 +65,13 @@ int main(int argc, char** argv) {
   std::vector<Command> sorted = commands();
   std::sort(sorted.begin(), sorted.end(), [](const Command& a, const Command& b) { return a.name < b.name; });
   std::map<CLI::App*, CommandRunner> runners;
+  auto list = std::make_shared<CommandListFormatter>();
   for (const Command& c : sorted) {
     CLI::App* sub = app.add_subcommand(c.name, c.description);
+    list->summary(sub, c.description);
     runners[sub] = c.setup(*sub);
   }
+  app.formatter(list);  // after the subcommands: theirs keep the default formatter
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
