@@ -16,7 +16,29 @@ install(FILES ${_changelog_gz} cmake/deb/copyright DESTINATION ${CMAKE_INSTALL_D
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME fusedet)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
-set(CPACK_PACKAGE_CONTACT "fusedet maintainers <maintainers@users.noreply.h-seed-b2ba83ed.example>")
+# Maintainer: the person who builds the package answers for it - DEBFULLNAME / DEBEMAIL as Debian's
+# own tools (dch, debmake) take them, else the git identity of the checkout; set
+# -DFUSEDET_PACKAGE_MAINTAINER="Name <address>" to choose another.
+if(DEFINED ENV{DEBFULLNAME} AND DEFINED ENV{DEBEMAIL})
+  set(_maintainer "$ENV{DEBFULLNAME} <$ENV{DEBEMAIL}>")
+else()
+  find_package(Git QUIET)
+  if(GIT_FOUND)
+    execute_process(COMMAND ${GIT_EXECUTABLE} config user.name WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+                    OUTPUT_VARIABLE _name OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+    execute_process(COMMAND ${GIT_EXECUTABLE} config user.email WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+                    OUTPUT_VARIABLE _email OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET)
+    if(_name AND _email)
+      set(_maintainer "${_name} <${_email}>")
+    endif()
+  endif()
+endif()
+set(FUSEDET_PACKAGE_MAINTAINER "${_maintainer}" CACHE STRING "Maintainer field of the Debian package: Name <address>")
+if(NOT FUSEDET_PACKAGE_MAINTAINER MATCHES "^[^<>]+ <[^<>@ ]+@[^<>@ ]+>$")
+  message(WARNING "FUSEDET_PACKAGE_MAINTAINER '${FUSEDET_PACKAGE_MAINTAINER}' is not 'Name <address>': set it, or "
+                  "DEBFULLNAME and DEBEMAIL, before building the Debian package")
+endif()
+set(CPACK_PACKAGE_CONTACT "${FUSEDET_PACKAGE_MAINTAINER}")
 set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "object detection for robots from a colour camera and a tilting laser")
 # The synopsis line is CPACK_PACKAGE_DESCRIPTION_SUMMARY; this is the extended description.
 set(CPACK_DEBIAN_PACKAGE_DESCRIPTION "fusedetd fuses a SICK LMS 291 laser scanner nodded by a CANopen tilt motor
@@ -26,8 +48,8 @@ object class on them and serves the detections (class, score, image box,
 service with socket activation and a watchdog.
 .
 The package contains fusedetd, the fusedet command line (device checks,
-training, evaluation, query client), the lms291-sim and tilt-sim device
-simulators, the bundled car, bike and person models and the systemd units.
+training, evaluation, query client), the bundled car, bike and person models
+(trained on KITTI: CC BY-NC-SA 3.0, non-commercial) and the systemd units.
 The units are not enabled on installation: configure the devices in
 /etc/fusedet/fusedet.yaml first.")
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)

@@ -19,15 +19,15 @@ echo "package: $(basename "$deb") ($(stat -c %s "$deb") bytes)"
 
 # Files: everything a robot needs, at the FHS places.
 contents=$(dpkg-deb -c "$deb" | awk '{print $6}')
-for f in ./usr/bin/fusedet ./usr/bin/fusedetd ./usr/bin/lms291-sim ./usr/bin/tilt-sim \
+for f in ./usr/bin/fusedet ./usr/bin/fusedetd \
          ./etc/fusedet/fusedet.yaml ./lib/systemd/system/fusedetd.service ./lib/systemd/system/fusedetd.socket \
          ./usr/lib/sysusers.d/fusedet.conf ./usr/share/fusedet/models/car.json ./usr/share/fusedet/models/bike.json \
          ./usr/share/fusedet/models/person.json ./usr/share/doc/fusedet/copyright ./usr/share/doc/fusedet/changelog.gz \
          ./usr/share/doc/fusedet/protocol.md; do
   grep -qxF "$f" <<<"$contents" || fail "missing from the package: $f"
 done
-# ... and nothing from the development side or the build tree's prefix.
-if stray=$(grep -E '^\./usr/(include|local)/|\.a$|\.so$|^\./usr/etc/|^\./usr/lib/systemd/' <<<"$contents"); then
+# ... and nothing from the development side, the test simulators or the build tree's prefix.
+if stray=$(grep -E '^\./usr/(include|local)/|\.a$|\.so$|^\./usr/etc/|^\./usr/lib/systemd/|-sim$' <<<"$contents"); then
   fail "files that do not belong in the package: $stray"
 fi
 echo "files: $(grep -vc '/$' <<<"$contents") ok"
@@ -46,7 +46,11 @@ depends=$(dpkg-deb -f "$deb" Depends)
 for d in libc6 libstdc++6 libopencv-core libsystemd0 libusb-1.0-0 libyaml-cpp 'systemd | systemd-standalone-sysusers'; do
   grep -qF "$d" <<<"$depends" || fail "Depends lacks $d: $depends"
 done
-echo "control: conffiles, maintainer scripts and Depends ok"
+maintainer=$(dpkg-deb -f "$deb" Maintainer)
+configured=$(sed -n 's/^FUSEDET_PACKAGE_MAINTAINER:STRING=//p' "$build/CMakeCache.txt")
+[[ $maintainer == "$configured" && $maintainer =~ ^[^\<\>]+\ \<[^\<\>@\ ]+@[^\<\>@\ ]+\>$ ]] ||
+  fail "Maintainer '$maintainer' is not the configured 'Name <address>' ('$configured')"
+echo "control: conffiles, maintainer scripts, Depends and Maintainer ($maintainer) ok"
 
 # Payload: units, group, config.
 dpkg-deb -x "$deb" "$tmp/root"
@@ -60,7 +64,12 @@ cmp -s "$tmp/root/etc/fusedet/fusedet.yaml" "$src/config/fusedet.yaml" || fail "
 for m in car bike person; do
   cmp -s "$tmp/root/usr/share/fusedet/models/$m.json" "$src/models/$m.json" || fail "model $m differs from models/$m.json"
 done
-echo "payload: units, group '$group', config and models ok"
+# The copyright file names the code's licence (LICENSE) and the models' KITTI-derived one.
+grep -qx 'License: Apache-2.0' "$tmp/root/usr/share/doc/fusedet/copyright" || fail "copyright: no Apache-2.0 paragraph"
+grep -q 'Apache License' "$src/LICENSE" || fail "LICENSE is not the Apache License"
+awk '/^Files: models\/\*/{m=1} m && /^License:/{print; exit}' "$tmp/root/usr/share/doc/fusedet/copyright" |
+  grep -qx 'License: CC-BY-NC-SA-3.0' || fail "copyright: the models are not CC-BY-NC-SA-3.0"
+echo "payload: units, group '$group', config, models and copyright ok"
 
 # lintian: no errors (warnings are listed in docs/packaging.md).
 lintian --tag-display-limit 0 "$deb" >"$tmp/lintian.log" 2>&1 && rc=0 || rc=$?
