@@ -55,6 +55,19 @@ std::vector<int> bestMatching(const std::vector<std::vector<double>>& score, std
   return best;
 }
 
+// One frame's matching: IoU >= 0.5 pairs, a pair kept from the previous frame preferred.
+std::vector<int> matchFrame(const MotFrame& f, const std::map<std::int64_t, std::int64_t>& prevFrameMatch) {
+  std::vector<std::vector<double>> score(f.truth.size(), std::vector<double>(f.hypotheses.size(), 0));
+  for (std::size_t i = 0; i < f.truth.size(); ++i)
+    for (std::size_t j = 0; j < f.hypotheses.size(); ++j) {
+      const double s = overlap(f.truth[i].box, f.hypotheses[j].box);
+      if (s < 0.5) continue;
+      const auto p = prevFrameMatch.find(f.truth[i].id);
+      score[i][j] = s + (p != prevFrameMatch.end() && p->second == f.hypotheses[j].id ? 1000 : 0);
+    }
+  return bestMatching(score, f.hypotheses.size());
+}
+
 struct RefClear {
   double tp = 0, fn = 0, fp = 0, idsw = 0, iou = 0;
 };
@@ -63,15 +76,7 @@ RefClear referenceClear(const MotSequence& seq) {
   RefClear r;
   std::map<std::int64_t, std::int64_t> lastMatch, prevFrameMatch;
   for (const MotFrame& f : seq) {
-    std::vector<std::vector<double>> score(f.truth.size(), std::vector<double>(f.hypotheses.size(), 0));
-    for (std::size_t i = 0; i < f.truth.size(); ++i)
-      for (std::size_t j = 0; j < f.hypotheses.size(); ++j) {
-        const double s = overlap(f.truth[i].box, f.hypotheses[j].box);
-        if (s < 0.5) continue;
-        const auto p = prevFrameMatch.find(f.truth[i].id);
-        score[i][j] = s + (p != prevFrameMatch.end() && p->second == f.hypotheses[j].id ? 1000 : 0);
-      }
-    const std::vector<int> m = bestMatching(score, f.hypotheses.size());
+    const std::vector<int> m = matchFrame(f, prevFrameMatch);
     std::map<std::int64_t, std::int64_t> now;
     double matched = 0;
     for (std::size_t i = 0; i < f.truth.size(); ++i) {
@@ -99,15 +104,7 @@ double referenceFrag(const MotSequence& seq) {
   std::map<std::int64_t, std::int64_t> prevFrameMatch;
   for (std::size_t k = 0; k < seq.size(); ++k) {
     const MotFrame& f = seq[k];
-    std::vector<std::vector<double>> score(f.truth.size(), std::vector<double>(f.hypotheses.size(), 0));
-    for (std::size_t i = 0; i < f.truth.size(); ++i)
-      for (std::size_t j = 0; j < f.hypotheses.size(); ++j) {
-        const double s = overlap(f.truth[i].box, f.hypotheses[j].box);
-        if (s < 0.5) continue;
-        const auto p = prevFrameMatch.find(f.truth[i].id);
-        score[i][j] = s + (p != prevFrameMatch.end() && p->second == f.hypotheses[j].id ? 1000 : 0);
-      }
-    const std::vector<int> m = bestMatching(score, f.hypotheses.size());
+    const std::vector<int> m = matchFrame(f, prevFrameMatch);
     prevFrameMatch.clear();
     for (std::size_t i = 0; i < f.truth.size(); ++i)
       if (m[i] >= 0) {
