@@ -10,7 +10,7 @@
 #include <opencv2/objdetect.hpp>
 #include <random>
 
-#include "../../../boost/src/opencv_pyramid.h"
+#include "../../../boost/detect/src/opencv_pyramid.h"
 
 using namespace fusedet;
 using namespace fusedet::boosting;

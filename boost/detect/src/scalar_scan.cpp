@@ -1,9 +1,9 @@
-#include "scalar_scan.h"
+#include "fusedet/boost/scalar_scan.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "window_scanner.h"
+#include "fusedet/boost/window_scanner.h"
 
 namespace fusedet::boosting {
 

@@ -1,4 +1,4 @@
-#include "integral_grids.h"
+#include "fusedet/boost/integral_grids.h"
 
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>

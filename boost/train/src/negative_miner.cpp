@@ -6,8 +6,8 @@
 
 #include <random>
 
-#include "scalar_scan.h"
-#include "window_scanner.h"
+#include "fusedet/boost/scalar_scan.h"
+#include "fusedet/boost/window_scanner.h"
 
 namespace fusedet::boosting {
 

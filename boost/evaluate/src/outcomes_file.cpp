@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "text_position.h"
+#include "fusedet/boost/text_position.h"
 
 namespace fusedet::boosting {
 namespace {

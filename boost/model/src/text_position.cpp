@@ -1,4 +1,4 @@
-#include "text_position.h"
+#include "fusedet/boost/text_position.h"
 
 namespace fusedet::boosting {
 

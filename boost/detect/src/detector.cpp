@@ -1,9 +1,9 @@
 #include "fusedet/boost/detector.h"
 
-#include "integral_grids.h"
+#include "fusedet/boost/integral_grids.h"
 #include "opencv_pyramid.h"
-#include "scalar_scan.h"
-#include "window_scanner.h"
+#include "fusedet/boost/scalar_scan.h"
+#include "fusedet/boost/window_scanner.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>

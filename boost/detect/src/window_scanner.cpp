@@ -1,4 +1,4 @@
-#include "window_scanner.h"
+#include "fusedet/boost/window_scanner.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>

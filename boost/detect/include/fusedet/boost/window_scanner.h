@@ -15,7 +15,7 @@
 
 #include "fusedet/boost/cascade.h"
 #include "fusedet/boost/detector.h"
-#include "integral_grids.h"
+#include "fusedet/boost/integral_grids.h"
 
 namespace fusedet::boosting {
 

@@ -9,7 +9,7 @@
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/integral_stack.h"
 #include "fusedet/boost/laser_extent.h"
-#include "window_scanner.h"
+#include "fusedet/boost/window_scanner.h"
 
 namespace fusedet::boosting {
 

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "text_position.h"
+#include "fusedet/boost/text_position.h"
 
 namespace fusedet::boosting {
 

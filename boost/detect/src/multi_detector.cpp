@@ -2,9 +2,9 @@
 
 #include "fusedet/boost/class_detection.h"
 
-#include "integral_grids.h"
+#include "fusedet/boost/integral_grids.h"
 #include "opencv_pyramid.h"
-#include "window_scanner.h"
+#include "fusedet/boost/window_scanner.h"
 
 namespace fusedet::boosting {
 
