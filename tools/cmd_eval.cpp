@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "command.h"
-#include "experiments_report.h"
+#include "experiments/report.h"
 #include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/data_split.h"

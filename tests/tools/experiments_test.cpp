@@ -11,8 +11,8 @@
 #include <set>
 #include <opencv2/core.hpp>
 
-#include "../../tools/experiments_peers.h"
-#include "../../tools/experiments_report.h"
+#include "../../tools/experiments/peers.h"
+#include "../../tools/experiments/report.h"
 #include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/data_split.h"

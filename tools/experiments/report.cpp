@@ -1,4 +1,4 @@
-#include "experiments_report.h"
+#include "report.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "experiments_peers.h"
+#include "peers.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
