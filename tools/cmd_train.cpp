@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "command.h"
+#include "training_options.h"
 #include "mpi_job.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/chain_evaluation.h"
@@ -36,14 +37,12 @@ struct TrainOptions {
   std::string className = "car";
   std::string layers = "red,green,blue,intensity,hue_distance,distance,remission";
   std::string types = "all";
-  int grid = 16, positionStep = 1, sizeStep = 1, minCell = 1;
+  int positionStep = 1, sizeStep = 1, minCell = 1;
   int windowHeight = 24;
-  double minHit = 0.995, maxFa = 0.5, targetFa = 1e-5;
-  int stages = 20, rounds = 100;
-  std::size_t negatives = 0;
+  double minHit = 0.995;
+  TrainingOptions training;  // training_options.h: grid, stages, rounds, false alarms, negatives, scan
   double minHeight = 25;
   int maxOcclusion = 1;
-  double scaleFactor = 1.2, step = 2;
   std::uint64_t seed = 1;
   int threads = 0;
   double split = 2.0 / 3.0;
@@ -187,13 +186,21 @@ void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
   std::printf("\n");
 }
 
+// fusedet train's training settings where no option is given: the trainer's, with a coarser negative
+// scan (scale step 1.2, step 2).
+boosting::TrainingConfig trainDefaults() {
+  boosting::TrainingConfig c;
+  c.samples.scan.scaleFactor = 1.2;
+  c.samples.scan.step = 2;
+  return c;
+}
+
 int runTrain(const TrainOptions& o, MpiJob* job) {
   const bool talk = !job || job->rank() == 0;  // only rank 0 prints
-  boosting::TrainingConfig c;
+  boosting::TrainingConfig c = trainDefaults();
   c.className = o.className;
   c.pool.layers = splitList(o.layers);
   c.pool.types = boosting::parseFeatureTypes(o.types);
-  c.pool.grid = o.grid;
   c.pool.positionStep = o.positionStep;
   c.pool.sizeStep = o.sizeStep;
   c.pool.minCellSize = o.minCell;
@@ -201,14 +208,8 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.samples.minPositiveHeight = o.minHeight;
   c.samples.maxOcclusion = o.maxOcclusion;
   c.samples.ignoreClasses = boosting::neighbourClasses(o.className);
-  c.samples.scan.scaleFactor = o.scaleFactor;
-  c.samples.scan.step = o.step;
   c.stage.minHit = o.minHit;
-  c.stage.maxFalseAlarm = o.maxFa;
-  c.stage.maxWeak = o.rounds;
-  c.targetFalseAlarm = o.targetFa;
-  c.maxStages = o.stages;
-  c.negativesPerStage = o.negatives;
+  o.training.applyTo(c);
   c.seed = o.seed;
   c.threads = o.threads;
   c.validate();
@@ -272,7 +273,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
                  (trainIds.size() + static_cast<std::size_t>(job->size()) - 1) / static_cast<std::size_t>(job->size()));
 
   const bool tty = o.progress == "tty" || (o.progress == "auto" && isatty(STDERR_FILENO));
-  ConsoleProgress console(tty, o.maxFa, o.targetFa);
+  ConsoleProgress console(tty, c.stage.maxFalseAlarm, c.targetFalseAlarm);
   boosting::NullProgress quiet;
   boosting::TrainingReport report;
   const boosting::Cascade cascade =
@@ -285,12 +286,12 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
       {"train_items", std::to_string(trainIds.size())},
       {"layers", o.layers},
       {"types", o.types},
-      {"grid", std::to_string(o.grid)},
+      {"grid", std::to_string(c.pool.grid)},
       {"pool_size", std::to_string(report.poolSize)},
       {"positives", std::to_string(report.positives)},
       {"seed", std::to_string(o.seed)},
       {"min_hit", std::to_string(o.minHit)},
-      {"max_fa", std::to_string(o.maxFa)},
+      {"max_fa", std::to_string(c.stage.maxFalseAlarm)},
       {"stop_reason", report.stopReason},
   };
   boosting::saveModel(cascade, out, info);
@@ -323,8 +324,7 @@ const bool registered = registerCommand(
                      "feature types of the pool: letters a-j (paper Fig. 1) and ranges, e.g. a-f (no corner "
                      "features), g-j, or all")
           ->capture_default_str();
-      app.add_option("--grid", o->grid, "grid units per side of the unit square the pool is laid on")
-          ->capture_default_str();
+      addTrainingOptions(app, o->training, "", defaultsOf(trainDefaults()));
       app.add_option("--position-step", o->positionStep, "feature positions every n grid units")
           ->capture_default_str();
       app.add_option("--size-step", o->sizeStep, "feature cell sizes every n grid units")->capture_default_str();
@@ -334,21 +334,9 @@ const bool registered = registerCommand(
                      "median aspect ratio of the positives")
           ->capture_default_str();
       app.add_option("--min-hit", o->minHit, "hit rate every stage keeps on its positives")->capture_default_str();
-      app.add_option("--max-fa", o->maxFa, "false-alarm rate at which a stage is complete")->capture_default_str();
-      app.add_option("--target-fa", o->targetFa,
-                     "stop when the cascade accepts at most this share of the label-free windows")
-          ->capture_default_str();
-      app.add_option("--stages", o->stages, "stage limit")->capture_default_str();
-      app.add_option("--rounds", o->rounds, "boosting rounds (stumps) per stage at most")->capture_default_str();
-      app.add_option("--negatives", o->negatives, "negatives per stage (0 = max(500, 2 x positives))")
-          ->capture_default_str();
       app.add_option("--min-height", o->minHeight, "[px] smaller labels of the class are not used as positives")
           ->capture_default_str();
       app.add_option("--max-occlusion", o->maxOcclusion, "more occluded labels (KITTI level) are not positives")
-          ->capture_default_str();
-      app.add_option("--scale-factor", o->scaleFactor, "window scale step of the negative bootstrapping scan")
-          ->capture_default_str();
-      app.add_option("--step", o->step, "position step of that scan, in window pixels at the base size")
           ->capture_default_str();
       app.add_option("--seed", o->seed, "seed of the negative sampling (same seed + data = same model file)")
           ->capture_default_str();

@@ -63,13 +63,14 @@ std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& val
 
 boosting::ExperimentPlan planFor(const ExperimentOptions& o) {
   boosting::ExperimentPlan p = boosting::experimentPlan(o.preset);
-  if (o.grid > 0) p.grid = o.grid;
-  if (o.maxStages > 0) p.maxStages = o.maxStages;
-  if (o.maxWeak > 0) p.maxWeak = o.maxWeak;
-  if (o.targetFalseAlarm > 0) p.targetFalseAlarm = o.targetFalseAlarm;
-  if (o.negatives) p.negatives = *o.negatives;
-  if (o.trainScaleFactor > 0) p.trainScaleFactor = o.trainScaleFactor;
-  if (o.trainStep > 0) p.trainStep = o.trainStep;
+  const TrainingOptions& t = o.training;
+  if (t.grid) p.grid = *t.grid;
+  if (t.stages) p.maxStages = *t.stages;
+  if (t.rounds) p.maxWeak = *t.rounds;
+  if (t.targetFa) p.targetFalseAlarm = *t.targetFa;
+  if (t.negatives) p.negatives = *t.negatives;
+  if (t.scanScaleFactor) p.trainScaleFactor = *t.scanScaleFactor;
+  if (t.scanStep) p.trainStep = *t.scanStep;
   if (o.scaleFactor > 0) p.scaleFactor = o.scaleFactor;
   if (o.step > 0) p.step = o.step;
   if (o.folds >= 0) p.folds = o.folds;
@@ -108,7 +109,7 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.samples.scan.scaleFactor = p.trainScaleFactor;
   c.samples.scan.step = p.trainStep;
   c.stage.maxWeak = p.maxWeak;
-  c.stage.maxFalseAlarm = o.stageMaxFalseAlarm;
+  if (o.training.maxFa) c.stage.maxFalseAlarm = *o.training.maxFa;
   c.stage.threads = o.threads;
   c.targetFalseAlarm = p.targetFalseAlarm;
   c.maxStages = p.maxStages;
@@ -256,23 +257,20 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                  "enlarge images by this factor for HOG, whose 64x128 window exceeds many KITTI pedestrians" +
                      presets(&boosting::ExperimentPlan::peerUpscale))
       ->check(CLI::Range(0.5, 4.0));
-  app.add_option("--grid", o->grid, "feature pool grid, units per side" +
-                                        presets(&boosting::ExperimentPlan::grid));
-  app.add_option("--max-stages", o->maxStages,
-                 "stage limit" + presets(&boosting::ExperimentPlan::maxStages));
-  app.add_option("--max-weak", o->maxWeak, "stumps per stage at most" + presets(&boosting::ExperimentPlan::maxWeak));
-  app.add_option("--target-fa", o->targetFalseAlarm,
-                 "target false-alarm rate of the cascade" +
-                     presets(&boosting::ExperimentPlan::targetFalseAlarm));
-  app.add_option("--negatives", o->negatives,
-                 "negatives per stage; 0 = the trainer's rule, max(500, 2 x positives), as `fusedet train`" +
-                     presets(&boosting::ExperimentPlan::negatives));
-  app.add_option("--train-scale-factor", o->trainScaleFactor,
-                 "scale step of the training scan that bootstraps negatives" +
-                     presets(&boosting::ExperimentPlan::trainScaleFactor));
-  app.add_option("--train-step", o->trainStep,
-                 "position step of that scan, in base-window pixels" +
-                     presets(&boosting::ExperimentPlan::trainStep));
+  addTrainingOptions(app, o->training, "train-", [](TrainingField f) {
+    using P = boosting::ExperimentPlan;
+    switch (f) {
+      case TrainingField::kGrid: return presets(&P::grid);
+      case TrainingField::kStages: return presets(&P::maxStages);
+      case TrainingField::kRounds: return presets(&P::maxWeak);
+      case TrainingField::kTargetFa: return presets(&P::targetFalseAlarm);
+      case TrainingField::kNegatives: return presets(&P::negatives);
+      case TrainingField::kScanScaleFactor: return presets(&P::trainScaleFactor);
+      case TrainingField::kScanStep: return presets(&P::trainStep);
+      case TrainingField::kMaxFa: break;
+    }
+    return defaultsOf(boosting::TrainingConfig{})(f);
+  });
   app.add_option("--scale-factor", o->scaleFactor,
                  "detection scale step on the test frames" +
                      presets(&boosting::ExperimentPlan::scaleFactor));
@@ -292,11 +290,6 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
                "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
                "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
-  app.add_option("--max-fa", o->stageMaxFalseAlarm,
-                 "false-alarm rate at which a stage is complete, as `fusedet train --max-fa`: lower = fewer, "
-                 "longer stages whose sums average more stumps")
-      ->check(CLI::Range(1e-6, 0.99))
-      ->capture_default_str();
   app.add_option("--class-stages", o->classStagesText,
          "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
          "stages in every configuration and the learning curve (the same cascades as training with a stage "

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../data_dir.h"
+#include "../training_options.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/experiments/cross_validation.h"
 #include "fusedet/experiments/experiment_plan.h"
@@ -43,10 +44,7 @@ struct ExperimentOptions {
   bool peers = true;
   double peerUpscale = 0;  // 0 = the preset's
   // Training; 0 = the preset's.
-  int grid = 0, maxStages = 0, maxWeak = 0;
-  double targetFalseAlarm = 0;
-  std::optional<std::size_t> negatives;  // 0 = the trainer's rule, max(500, 2 x positives)
-  double trainScaleFactor = 0, trainStep = 0;
+  TrainingOptions training;  // ../training_options.h, as fusedet train's; not given = the preset's
   double scaleFactor = 0;
   double step = 0;
   int minNeighbors = 3;
@@ -56,7 +54,6 @@ struct ExperimentOptions {
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
   std::size_t minPositives = 4;
-  double stageMaxFalseAlarm = 0.5;                 // a stage is complete at this false-alarm rate
   std::vector<std::string> classStagesText;       // --class-stages as given, parsed by runExperiments
   std::map<std::string, std::size_t> classStages;  // class -> stages its cascades keep (0/absent = all)
   std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to

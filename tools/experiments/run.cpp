@@ -171,7 +171,7 @@ int runExperiments(ExperimentOptions o) {
       {"max stumps per stage", std::to_string(preset.maxWeak)},
       {"target false-alarm rate", shortNum(preset.targetFalseAlarm)},
       {"negatives per stage", preset.negatives ? std::to_string(preset.negatives) : "max(500, 2 x positives)"},
-      {"stage min hit / max false alarm", "0.995 / " + shortNum(o.stageMaxFalseAlarm)},
+      {"stage min hit / max false alarm", "0.995 / " + shortNum(o.training.maxFa.value_or(boosting::StageConfig{}.maxFalseAlarm))},
       {"seed (training and bootstrap)", std::to_string(o.seed)},
       {"bootstrap resamples", std::to_string(preset.resamples)},
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
