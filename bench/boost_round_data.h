@@ -58,7 +58,7 @@ inline RoundData syntheticRoundData(std::size_t features, std::size_t samples) {
 #include "fusedet/boost/feature_pool.h"
 #include "fusedet/boost/sample_features.h"
 #include "fusedet/boost/training_set.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace bench {
 

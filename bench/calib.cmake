@@ -2,5 +2,5 @@
 # (timed CLI, not Google Benchmark). Its ctest run is issue 17's acceptance run with the defaults
 # (10 trials, 10 frames, starts 1-2 deg / 5-10 cm off): it prints the error table and exits 1 when a
 # median error exceeds 0.3 deg / 3 cm. About 30 s CPU; see README.md.
-fusedet_bench(bench_calib_kitti SOURCES calib_kitti_bench.cpp DEPS fusedet_fusion CLI11::CLI11
+fusedet_bench(bench_calib_kitti SOURCES calib_kitti_bench.cpp DEPS fusedet_calibration CLI11::CLI11
               SMOKE_ARGS --trials 10 --frames 10 --max-rotation-deg 0.3 --max-translation 0.03)

@@ -16,9 +16,9 @@
 #include <sstream>
 
 #include "fusedet/core/cpu_time.h"
-#include "fusedet/fusion/calib_kitti.h"
-#include "fusedet/fusion/calib_targetless.h"
-#include "fusedet/fusion/score_profile.h"
+#include "fusedet/fusion/calibration/calib_kitti.h"
+#include "fusedet/fusion/calibration/calib_targetless.h"
+#include "fusedet/fusion/calibration/score_profile.h"
 
 namespace {
 

@@ -19,7 +19,7 @@
 #include "fusedet/daemon/service_parts.h"
 #include "fusedet/daemon/stats.h"
 #include "fusedet/daemon/thread_info.h"
-#include "fusedet/fusion/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;

@@ -6,6 +6,6 @@ fusedet_bench(bench_detect_vs_opencv SOURCES detect_vs_opencv.cpp
 # All three bundled classes on one real fused KITTI stack in one pass, vs the previous per-class path
 # and cv::CascadeClassifier (frontalface_default) on the same stack's intensity layer.
 fusedet_bench(bench_detect3 SOURCES detect3_bench.cpp
-              DEPS fusedet_boost_detect fusedet_fusion opencv_objdetect opencv_core CLI11::CLI11
+              DEPS fusedet_boost_detect fusedet_datasets opencv_objdetect opencv_core CLI11::CLI11
               SMOKE_ARGS --smoke)
 target_compile_definitions(bench_detect3 PRIVATE FUSEDET_MODELS_DIR="${PROJECT_SOURCE_DIR}/models")

@@ -39,7 +39,7 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/core/cpu_time.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace {
 

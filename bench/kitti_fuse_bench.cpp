@@ -23,7 +23,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "fusedet/fusion/camera_layers.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 #include "fusedet/fusion/undistorter.h"
 
 #include "headline_reporter.h"

@@ -8,7 +8,7 @@
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 #include "headline_reporter.h"
 

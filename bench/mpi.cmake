@@ -3,7 +3,7 @@
 # smoke run uses a small pool on 3 frames per drive.
 if(FUSEDET_MPI)
   fusedet_bench(bench_mpi_round SOURCES mpi_round_bench.cpp
-                DEPS fusedet_boost_train fusedet_fusion fusedet_mpi_loader opencv_imgproc opencv_core CLI11::CLI11
+                DEPS fusedet_boost_train fusedet_datasets fusedet_mpi_loader opencv_imgproc opencv_core CLI11::CLI11
                 SMOKE_ARGS --smoke)
   target_compile_definitions(bench_mpi_round PRIVATE FUSEDET_MPIRUN="${FUSEDET_MPIRUN}"
                              FUSEDET_MPI_MODULE_PATH="$<TARGET_FILE:fusedet_mpi>")

@@ -6,6 +6,6 @@
 find_library(FUSEDET_XGBOOST_LIB NAMES xgboost REQUIRED)
 find_path(FUSEDET_XGBOOST_INCLUDE xgboost/c_api.h REQUIRED)
 fusedet_bench(bench_boost_round SOURCES boost_round_bench.cpp
-              DEPS fusedet_boost_train fusedet_fusion ${FUSEDET_XGBOOST_LIB} opencv_imgproc opencv_ml opencv_core TBB::tbb CLI11::CLI11
+              DEPS fusedet_boost_train fusedet_datasets ${FUSEDET_XGBOOST_LIB} opencv_imgproc opencv_ml opencv_core TBB::tbb CLI11::CLI11
               SMOKE_ARGS --smoke)
 target_include_directories(bench_boost_round SYSTEM PRIVATE ${FUSEDET_XGBOOST_INCLUDE})

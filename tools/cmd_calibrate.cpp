@@ -10,12 +10,12 @@
 
 #include "command.h"
 #include "fusedet/daemon/calib_log.h"
-#include "fusedet/fusion/calib_kitti.h"
-#include "fusedet/fusion/calib_overlay.h"
-#include "fusedet/fusion/calib_targetless.h"
+#include "fusedet/fusion/calibration/calib_kitti.h"
+#include "fusedet/fusion/calibration/calib_overlay.h"
+#include "fusedet/fusion/calibration/calib_targetless.h"
 #include "fusedet/fusion/camera_model.h"
-#include "fusedet/fusion/extrinsics_file.h"
-#include "fusedet/fusion/score_profile.h"
+#include "fusedet/fusion/calibration/extrinsics_file.h"
+#include "fusedet/fusion/calibration/score_profile.h"
 
 namespace fusedet::tools {
 namespace {

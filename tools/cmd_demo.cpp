@@ -19,7 +19,7 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/core/layer_stack.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 #include "fusedet/fusion/projection.h"
 
 namespace fusedet::tools {

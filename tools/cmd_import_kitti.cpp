@@ -6,7 +6,7 @@
 
 #include "command.h"
 #include "data_dir.h"
-#include "fusedet/fusion/kitti_import.h"
+#include "fusedet/fusion/datasets/kitti_import.h"
 
 namespace fusedet::tools {
 namespace {

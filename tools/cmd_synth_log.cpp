@@ -7,7 +7,7 @@
 #include "command.h"
 #include "data_dir.h"
 #include "fusedet/daemon/log_derive.h"
-#include "fusedet/fusion/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
 #include "model_files.h"
 
 namespace fusedet::tools {

@@ -14,8 +14,8 @@
 #include "command.h"
 #include "fusedet/drivers/log/channels.h"
 #include "fusedet/drivers/log/replay.h"
-#include "fusedet/fusion/kitti.h"
-#include "fusedet/fusion/kitti_tracks.h"
+#include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/datasets/kitti_tracks.h"
 #include "fusedet/tracking/kitti_tracking_eval.h"
 #include "fusedet/tracking/timeline_plot.h"
 

@@ -14,7 +14,7 @@
 
 #include "fusedet/daemon/calib_log.h"
 #include "fusedet/drivers/log/recorder.h"
-#include "fusedet/fusion/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
 
 namespace fusedet::daemon {
 namespace {

@@ -32,7 +32,7 @@
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/localize.h"
 #include "fusedet/daemon/stack_detector.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace fusedet::daemon {
 namespace {

@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <string>
 
-#include "fusedet/fusion/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
 
 namespace fusedet::testlogs {
 

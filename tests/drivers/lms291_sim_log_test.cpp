@@ -13,7 +13,7 @@
 
 #include "fusedet/drivers/lms291/lms291.h"
 #include "fusedet/drivers/log/replay.h"
-#include "fusedet/fusion/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
 #include "log_scans.h"
 #include "simulator.h"
 

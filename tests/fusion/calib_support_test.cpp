@@ -8,11 +8,11 @@
 #include <fstream>
 #include <random>
 
-#include "fusedet/fusion/calib_kitti.h"
-#include "fusedet/fusion/calib_targetless.h"
+#include "fusedet/fusion/calibration/calib_kitti.h"
+#include "fusedet/fusion/calibration/calib_targetless.h"
 #include "fusedet/fusion/camera_model.h"
-#include "fusedet/fusion/extrinsics_file.h"
-#include "fusedet/fusion/nelder_mead.h"
+#include "fusedet/fusion/calibration/extrinsics_file.h"
+#include "fusedet/fusion/calibration/nelder_mead.h"
 
 namespace fusedet::fusion {
 namespace {

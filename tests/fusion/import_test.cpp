@@ -7,9 +7,9 @@
 #include <opencv2/core.hpp>
 #include <random>
 
-#include "fusedet/fusion/detections_file.h"
-#include "fusedet/fusion/kitti_import.h"
-#include "fusedet/fusion/mosaic.h"
+#include "fusedet/fusion/drawing/detections_file.h"
+#include "fusedet/fusion/datasets/kitti_import.h"
+#include "fusedet/fusion/drawing/mosaic.h"
 
 namespace fs = std::filesystem;
 using namespace fusedet;

@@ -1,4 +1,4 @@
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 #include <gtest/gtest.h>
 

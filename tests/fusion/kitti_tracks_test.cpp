@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <set>
 
-#include "fusedet/fusion/kitti.h"
-#include "fusedet/fusion/kitti_tracks.h"
+#include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/datasets/kitti_tracks.h"
 
 namespace fusedet::fusion {
 namespace {

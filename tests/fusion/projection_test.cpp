@@ -13,7 +13,7 @@
 #include <opencv2/core.hpp>
 #include <sstream>
 
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace fs = std::filesystem;
 using namespace fusedet;

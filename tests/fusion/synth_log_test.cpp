@@ -20,12 +20,12 @@
 #include "fusedet/drivers/log/replay.h"
 #include "fusedet/fusion/frame_decode.h"
 #include "fusedet/fusion/fuser.h"
-#include "fusedet/fusion/kitti.h"
-#include "fusedet/fusion/kitti_import.h"
+#include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/datasets/kitti_import.h"
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
-#include "fusedet/fusion/synth_log.h"
-#include "fusedet/fusion/synth_scene.h"
+#include "fusedet/fusion/synthesis/synth_log.h"
+#include "fusedet/fusion/synthesis/synth_scene.h"
 
 namespace fs = std::filesystem;
 using namespace fusedet;

@@ -8,9 +8,9 @@
 #include <random>
 
 #include "fusedet/fusion/frame_decode.h"
-#include "fusedet/fusion/frame_encode.h"
-#include "fusedet/fusion/point_ray_caster.h"
-#include "fusedet/fusion/synth_scene.h"
+#include "fusedet/fusion/synthesis/frame_encode.h"
+#include "fusedet/fusion/synthesis/point_ray_caster.h"
+#include "fusedet/fusion/synthesis/synth_scene.h"
 
 using namespace fusedet;
 using namespace fusedet::fusion;

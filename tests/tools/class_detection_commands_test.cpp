@@ -19,7 +19,7 @@
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/core/dataset.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace fusedet::boosting {
 namespace {

@@ -16,7 +16,7 @@
 #include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/class_rules.h"
 #include "fusedet/boost/data_split.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace fusedet::tools::experiments {
 namespace {

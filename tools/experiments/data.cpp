@@ -8,9 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fusedet/fusion/kitti_drives.h"
-#include "fusedet/fusion/kitti_import.h"
-#include "fusedet/fusion/kitti_tracks.h"
+#include "fusedet/fusion/datasets/kitti_drives.h"
+#include "fusedet/fusion/datasets/kitti_import.h"
+#include "fusedet/fusion/datasets/kitti_tracks.h"
 
 namespace fusedet::tools::experiments {
 std::vector<fs::path> kittiDrives(const fs::path& root) {

@@ -14,7 +14,7 @@
 
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 using namespace fusedet;
 using namespace fusedet::boosting;

@@ -14,8 +14,8 @@
 
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/boost/model_io.h"
-#include "fusedet/fusion/kitti.h"
-#include "fusedet/fusion/kitti_import.h"
+#include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/datasets/kitti_import.h"
 
 using namespace fusedet;
 using namespace fusedet::boosting;

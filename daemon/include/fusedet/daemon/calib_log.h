@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "fusedet/fusion/calib_targetless.h"
+#include "fusedet/fusion/calibration/calib_targetless.h"
 
 namespace fusedet::daemon {
 

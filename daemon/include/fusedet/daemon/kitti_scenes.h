@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "fusedet/daemon/source.h"
-#include "fusedet/fusion/kitti.h"
+#include "fusedet/fusion/datasets/kitti.h"
 
 namespace fusedet::daemon {
 
