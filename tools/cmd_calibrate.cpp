@@ -9,7 +9,7 @@
 #include <sstream>
 
 #include "command.h"
-#include "fusedet/daemon/calib_log.h"
+#include "fusedet/sensor_logs/calib_log.h"
 #include "fusedet/fusion/calibration/calib_kitti.h"
 #include "fusedet/fusion/calibration/calib_overlay.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
@@ -65,7 +65,7 @@ Input loadInput(const CalibrateOptions& o) {
   if (o.kitti.empty() == o.log.empty()) throw std::runtime_error("give either --kitti DIR (one or more) or --log LOG");
   Input in;
   if (!o.log.empty()) {
-    daemon::LogCalibrationInput l = daemon::loadLogCalibrationInput(o.log, static_cast<std::size_t>(o.frames));
+    sensor_logs::LogCalibrationInput l = sensor_logs::loadLogCalibrationInput(o.log, static_cast<std::size_t>(o.frames));
     std::printf("frames    %zu of %zu sweeps paired with a camera frame (%zu sweeps in the log):", l.frames.size(), l.paired,
                 l.sweeps);
     in.frames = std::move(l.frames);

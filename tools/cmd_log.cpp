@@ -1,17 +1,17 @@
 // fusedet log: inspect and export MCAP sensor logs (docs/log-format.md).
 //   info LOG                          channels, counts, time span, gaps, damage (where a cut file was cut)
 //   export LOG --candump F | --png DIR | --ply DIR
-//   derive IN OUT [--models M...]     IN plus the channels a viewer needs (daemon/log_derive.h)
+//   derive IN OUT [--models M...]     IN plus the channels a viewer needs (tools/sensor_logs/log_derive.h)
 
 #include <cstdio>
 
 #include "command.h"
 #include "fusedet/daemon/config.h"
-#include "fusedet/daemon/log_derive.h"
+#include "fusedet/sensor_logs/log_derive.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/drivers/log/candump.h"
 #include "fusedet/drivers/log/log_info.h"
-#include "fusedet/fusion/log_export.h"
+#include "fusedet/sensor_logs/log_export.h"
 #include "model_files.h"
 
 namespace fusedet::tools {
@@ -27,9 +27,9 @@ struct LogOptions {
 };
 
 int runDerive(const LogOptions& o) {
-  daemon::DeriveOptions d;
+  sensor_logs::DeriveOptions d;
   if (!o.noDetections) d.models = modelFiles(o.models);
-  const daemon::DeriveReport r = daemon::deriveLog(o.file, o.out, d);
+  const sensor_logs::DeriveReport r = sensor_logs::deriveLog(o.file, o.out, d);
   std::printf("derive   %s -> %s: %ju raw messages copied, %ju derived messages of the input left out\n", o.file.c_str(),
               o.out.c_str(), static_cast<std::uintmax_t>(r.copied), static_cast<std::uintmax_t>(r.dropped));
   std::printf("laser    %ju scans, %ju tilt samples (%ju transforms), %ju sweeps with %ju points\n",
@@ -57,14 +57,14 @@ int runExport(const LogOptions& o) {
     std::printf("candump  %ju CAN frames -> %s\n", static_cast<std::uintmax_t>(drivers::logs::exportCandump(o.file, o.candump)),
                 o.candump.c_str());
   if (!o.png.empty())
-    std::printf("png      %ju camera frames -> %s\n", static_cast<std::uintmax_t>(fusion::exportFramesPng(o.file, o.png)),
+    std::printf("png      %ju camera frames -> %s\n", static_cast<std::uintmax_t>(sensor_logs::exportFramesPng(o.file, o.png)),
                 o.png.c_str());
   if (!o.ply.empty()) {
     // Sweeps are assembled with the rig the log carries (its fusedet.config), as replay does.
     const auto rig = drivers::logs::LogSource(o.file).rig();
     const daemon::Config config = rig ? daemon::parseConfig(rig->configYaml, o.file + ":fusedet.config") : daemon::Config{};
     if (!rig) std::fprintf(stderr, "log: %s has no fusedet.config; assembling sweeps with the default rig\n", o.file.c_str());
-    const std::uint64_t n = fusion::exportSweepsPly(o.file, daemon::sensorReplayConfig(config), daemon::sweepConfig(config), o.ply);
+    const std::uint64_t n = sensor_logs::exportSweepsPly(o.file, daemon::sensorReplayConfig(config), daemon::sweepConfig(config), o.ply);
     std::printf("ply      %ju sweeps -> %s\n", static_cast<std::uintmax_t>(n), o.ply.c_str());
   }
   return 0;

@@ -6,7 +6,7 @@
 
 #include "command.h"
 #include "data_dir.h"
-#include "fusedet/daemon/log_derive.h"
+#include "fusedet/sensor_logs/log_derive.h"
 #include "fusedet/fusion/synthesis/synth_log.h"
 #include "model_files.h"
 
@@ -40,7 +40,7 @@ int run(SynthCliOptions o) {
   const fs::path raw = o.derived ? fs::path(o.out + ".raw.tmp") : fs::path(o.out);
   const fusion::SynthReport r = fusion::synthesizeLog(o.synth, raw);
   if (o.derived) {
-    const daemon::DeriveReport d = daemon::deriveLog(raw, o.out, daemon::DeriveOptions{models});
+    const sensor_logs::DeriveReport d = sensor_logs::deriveLog(raw, o.out, sensor_logs::DeriveOptions{models});
     fs::remove(raw);
     std::printf("derived  %ju scans, %ju sweeps (%ju points), %ju stacks, %ju detections, %ju transforms\n",
                 static_cast<std::uintmax_t>(d.scans), static_cast<std::uintmax_t>(d.sweeps), static_cast<std::uintmax_t>(d.points),

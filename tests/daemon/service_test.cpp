@@ -15,12 +15,12 @@
 #include <utility>
 
 #include "fusedet/daemon/client.h"
-#include "fusedet/daemon/scene_source.h"
 #include "fusedet/daemon/service.h"
-#include "fusedet/daemon/kitti_scenes.h"
 #include "fusedet/daemon/service_parts.h"
 #include "fusedet/drivers/canopen/tilt_drive.h"
+#include "kitti_scenes.h"
 #include "replay_logs.h"
+#include "scene_source.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;

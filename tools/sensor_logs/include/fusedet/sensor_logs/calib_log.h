@@ -11,7 +11,7 @@
 
 #include "fusedet/fusion/calibration/calib_targetless.h"
 
-namespace fusedet::daemon {
+namespace fusedet::sensor_logs {
 
 struct LogCalibrationInput {
   std::vector<fusion::CalibFrame> frames;  // name "sweep-<id>"; images undistorted with the log's camera model
@@ -26,4 +26,4 @@ struct LogCalibrationInput {
 // Memory stays bounded by about 2 x maxFrames pairs, whatever the log's length.
 LogCalibrationInput loadLogCalibrationInput(const std::filesystem::path& log, std::size_t maxFrames);
 
-}  // namespace fusedet::daemon
+}  // namespace fusedet::sensor_logs

@@ -1,4 +1,4 @@
-#include "fusedet/fusion/log_export.h"
+#include "fusedet/sensor_logs/log_export.h"
 
 #include <cerrno>
 #include <cstring>
@@ -9,7 +9,10 @@
 #include "fusedet/drivers/log/mcap_reader.h"
 #include "fusedet/fusion/frame_decode.h"
 
-namespace fusedet::fusion {
+namespace fusedet::sensor_logs {
+
+using fusion::Sweep;
+using fusion::SweepPoint;
 
 namespace fs = std::filesystem;
 namespace logs = drivers::logs;
@@ -20,7 +23,7 @@ std::uint64_t exportFramesPng(const fs::path& log, const fs::path& dir) {
   std::uint64_t n = 0;
   logs::LogSource::Handlers h;
   h.camera = [&](const drivers::CameraFrame& f) {
-    auto bgr = decodeCameraFrame(f);
+    auto bgr = fusion::decodeCameraFrame(f);
     if (!bgr) throw std::runtime_error(log.string() + ": " + bgr.error().message());
     const fs::path file = dir / ("frame_" + std::to_string(f.sequence) + "_" + std::to_string(f.stamp.ns) + ".png");
     if (!cv::imwrite(file.string(), *bgr)) throw std::runtime_error(file.string() + ": cannot write PNG");
@@ -41,7 +44,7 @@ void writePly(const Sweep& sweep, const fs::path& file) {
   if (!out) throw std::runtime_error(file.string() + ": write error");
 }
 
-std::uint64_t exportSweepsPly(const fs::path& log, const logs::SensorReplayConfig& replayConfig, const SweepConfig& sweepConfig,
+std::uint64_t exportSweepsPly(const fs::path& log, const logs::SensorReplayConfig& replayConfig, const fusion::SweepConfig& sweepConfig,
                               const fs::path& dir) {
   fs::create_directories(dir);
   std::uint64_t n = 0;
@@ -67,7 +70,7 @@ std::uint64_t exportSweepsPly(const fs::path& log, const logs::SensorReplayConfi
   }
   // Otherwise: assemble them from the raw streams, as live.
   logs::SensorReplay replay(log, replayConfig);
-  SweepAssembler assembler(sweepConfig);
+  fusion::SweepAssembler assembler(sweepConfig);
   logs::SensorReplay::Handlers h;
   h.scan = [&](const drivers::LaserScan& s) { assembler.addScan(s); };
   h.tilt = [&](const drivers::TiltSample& t) { assembler.addTilt(t); };
@@ -78,4 +81,4 @@ std::uint64_t exportSweepsPly(const fs::path& log, const logs::SensorReplayConfi
   return n;
 }
 
-}  // namespace fusedet::fusion
+}  // namespace fusedet::sensor_logs

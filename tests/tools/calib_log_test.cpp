@@ -12,11 +12,11 @@
 #include <fstream>
 #include <random>
 
-#include "fusedet/daemon/calib_log.h"
 #include "fusedet/drivers/log/recorder.h"
 #include "fusedet/fusion/synthesis/synth_log.h"
+#include "fusedet/sensor_logs/calib_log.h"
 
-namespace fusedet::daemon {
+namespace fusedet::sensor_logs {
 namespace {
 
 namespace fs = std::filesystem;
@@ -125,4 +125,4 @@ TEST(CalibLog, TargetlessCalibrationFromAPerturbedStartReturnsToTheRig) {
 }
 
 }  // namespace
-}  // namespace fusedet::daemon
+}  // namespace fusedet::sensor_logs

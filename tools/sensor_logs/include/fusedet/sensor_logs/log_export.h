@@ -10,7 +10,7 @@
 #include "fusedet/drivers/log/replay.h"
 #include "fusedet/fusion/sweep_assembler.h"
 
-namespace fusedet::fusion {
+namespace fusedet::sensor_logs {
 
 // <dir>/frame_<sequence>_<stamp ns>.png per camera frame; returns the count. Throws on an
 // unreadable log, an undecodable frame (naming it) or an unwritable directory.
@@ -18,9 +18,9 @@ std::uint64_t exportFramesPng(const std::filesystem::path& log, const std::files
 
 // <dir>/sweep_<n>_<start ns>.ply (ASCII PLY: x y z remission, laser base frame) per sweep.
 std::uint64_t exportSweepsPly(const std::filesystem::path& log, const drivers::logs::SensorReplayConfig& replay,
-                              const SweepConfig& sweeps, const std::filesystem::path& dir);
+                              const fusion::SweepConfig& sweeps, const std::filesystem::path& dir);
 
 // One sweep as ASCII PLY (vertex x y z remission).
-void writePly(const Sweep& sweep, const std::filesystem::path& file);
+void writePly(const fusion::Sweep& sweep, const std::filesystem::path& file);
 
-}  // namespace fusedet::fusion
+}  // namespace fusedet::sensor_logs

@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace fusedet::daemon {
+namespace fusedet::sensor_logs {
 
 struct DeriveOptions {
   std::vector<std::filesystem::path> models;  // model files (*.json); none = no /detections
@@ -38,4 +38,4 @@ struct DeriveReport {
 // rig, a model file that does not load).
 DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::path& out, const DeriveOptions& options);
 
-}  // namespace fusedet::daemon
+}  // namespace fusedet::sensor_logs

@@ -1,4 +1,4 @@
-#include "fusedet/daemon/log_derive.h"
+#include "fusedet/sensor_logs/log_derive.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -14,7 +14,7 @@
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
 
-namespace fusedet::daemon {
+namespace fusedet::sensor_logs {
 
 namespace logs = drivers::logs;
 namespace mcap = drivers::mcap;
@@ -65,7 +65,7 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   const logs::LogSource probe(in);
   const auto rig = probe.rig();
   if (!rig) throw std::runtime_error(in.string() + ": no fusedet.config metadata (the rig) to replay it with");
-  const Config config = parseConfig(rig->configYaml, in.string() + ":config.yaml");
+  const daemon::Config config = daemon::parseConfig(rig->configYaml, in.string() + ":config.yaml");
   const fusion::SweepConfig sweepConfig = daemon::sweepConfig(config);
   const Eigen::Isometry3d laserToCamera = daemon::laserToCamera(config);
 
@@ -79,12 +79,12 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
     fuser.emplace(*camera, laserToCamera, projection);
     report.calibrated = true;
   }
-  std::unique_ptr<CascadeSet> detector;
+  std::unique_ptr<daemon::CascadeSet> detector;
   if (!options.models.empty()) {
-    Config::Detection d = config.detection;
+    daemon::Config::Detection d = config.detection;
     d.models.clear();
     for (const auto& m : options.models) d.models.push_back(m.string());
-    detector = std::make_unique<CascadeSet>(d);
+    detector = std::make_unique<daemon::CascadeSet>(d);
     report.classes = detector->classes();
   }
 
@@ -93,7 +93,7 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   auto keep = [&](Stamp t, const char* topic, logs::Schema schema, std::vector<std::uint8_t> json) {
     derived.push_back({t.ns, topic, schema, std::move(json)});
   };
-  logs::SensorReplay replay(in, sensorReplayConfig(config));
+  logs::SensorReplay replay(in, daemon::sensorReplayConfig(config));
   fusion::SweepAssembler sweeps(sweepConfig);
   fusion::FramePairer pairer(static_cast<std::int64_t>(config.fusion.maxPairSkewMs) * 1'000'000);
   const Eigen::Vector3d axis = sweepConfig.tiltAxis.normalized();
@@ -187,4 +187,4 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   return report;
 }
 
-}  // namespace fusedet::daemon
+}  // namespace fusedet::sensor_logs

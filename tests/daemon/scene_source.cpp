@@ -1,4 +1,4 @@
-#include "fusedet/daemon/scene_source.h"
+#include "scene_source.h"
 
 #include "fusedet/core/stamp.h"
 #include "fusedet/daemon/thread_info.h"

@@ -1,4 +1,4 @@
-#include "fusedet/daemon/calib_log.h"
+#include "fusedet/sensor_logs/calib_log.h"
 
 #include <stdexcept>
 #include <string>
@@ -13,7 +13,7 @@
 #include "fusedet/fusion/sweep_assembler.h"
 #include "fusedet/fusion/undistorter.h"
 
-namespace fusedet::daemon {
+namespace fusedet::sensor_logs {
 
 namespace {
 
@@ -52,11 +52,11 @@ LogCalibrationInput loadLogCalibrationInput(const std::filesystem::path& log, st
   const drivers::logs::LogSource probe(log);
   const auto rig = probe.rig();
   if (!rig) throw std::runtime_error(log.string() + ": the log carries no rig (metadata fusedet.config)");
-  const Config config = parseConfig(rig->configYaml, log.string() + ":fusedet.config");
+  const daemon::Config config = daemon::parseConfig(rig->configYaml, log.string() + ":fusedet.config");
   const fusion::CameraModel camera = fusion::parseCameraModel(rig->cameraYaml, log.string() + ":camera.yaml");
 
-  drivers::logs::SensorReplay replay(log, sensorReplayConfig(config));
-  fusion::SweepAssembler sweeps(sweepConfig(config));
+  drivers::logs::SensorReplay replay(log, daemon::sensorReplayConfig(config));
+  fusion::SweepAssembler sweeps(daemon::sweepConfig(config));
   fusion::FramePairer pairer(static_cast<std::int64_t>(config.fusion.maxPairSkewMs) * 1'000'000);
   EvenSample<std::pair<fusion::Sweep, drivers::CameraFrame>> sample(maxFrames);
   LogCalibrationInput in;
@@ -91,8 +91,8 @@ LogCalibrationInput loadLogCalibrationInput(const std::filesystem::path& log, st
     in.frames.push_back(std::move(f));
   }
   in.K = camera.K;
-  in.laserToCamera = laserToCamera(config);
+  in.laserToCamera = daemon::laserToCamera(config);
   return in;
 }
 
-}  // namespace fusedet::daemon
+}  // namespace fusedet::sensor_logs
