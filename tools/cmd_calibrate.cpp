@@ -9,13 +9,13 @@
 #include <sstream>
 
 #include "command.h"
-#include "fusedet/sensor_logs/calib_log.h"
 #include "fusedet/fusion/calibration/calib_kitti.h"
 #include "fusedet/fusion/calibration/calib_overlay.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
-#include "fusedet/fusion/camera_model.h"
 #include "fusedet/fusion/calibration/extrinsics_file.h"
 #include "fusedet/fusion/calibration/score_profile.h"
+#include "fusedet/fusion/camera_model.h"
+#include "fusedet/sensor_logs/calib_log.h"
 
 namespace fusedet::tools {
 namespace {

@@ -12,8 +12,8 @@
 
 #include "command.h"
 #include "data_dir.h"
-#include "fusedet/boost/data_split.h"
 #include "fusedet/boost/class_detection.h"
+#include "fusedet/boost/data_split.h"
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/grouping.h"
 #include "fusedet/boost/model_io.h"

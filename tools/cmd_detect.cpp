@@ -20,8 +20,8 @@
 #include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/core/dataset.h"
-#include "fusedet/fusion/drawing/box_drawing.h"
 #include "fusedet/fusion/camera_layers.h"
+#include "fusedet/fusion/drawing/box_drawing.h"
 
 namespace fusedet::tools {
 namespace {

@@ -7,10 +7,10 @@
 
 #include "command.h"
 #include "fusedet/daemon/config.h"
-#include "fusedet/sensor_logs/log_derive.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/drivers/log/candump.h"
 #include "fusedet/drivers/log/log_info.h"
+#include "fusedet/sensor_logs/log_derive.h"
 #include "fusedet/sensor_logs/log_export.h"
 #include "model_files.h"
 

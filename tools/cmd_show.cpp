@@ -9,8 +9,8 @@
 #include "command.h"
 #include "data_dir.h"
 #include "fusedet/core/dataset.h"
-#include "fusedet/fusion/drawing/detections_file.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
+#include "fusedet/fusion/drawing/detections_file.h"
 #include "fusedet/fusion/drawing/mosaic.h"
 
 namespace fusedet::tools {

@@ -6,8 +6,8 @@
 
 #include "command.h"
 #include "data_dir.h"
-#include "fusedet/sensor_logs/log_derive.h"
 #include "fusedet/fusion/synthesis/synth_log.h"
+#include "fusedet/sensor_logs/log_derive.h"
 #include "model_files.h"
 
 namespace fusedet::tools {

@@ -10,9 +10,9 @@
 
 #include "fusedet/fusion/calibration/calib_kitti.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
-#include "fusedet/fusion/camera_model.h"
 #include "fusedet/fusion/calibration/extrinsics_file.h"
 #include "fusedet/fusion/calibration/nelder_mead.h"
+#include "fusedet/fusion/camera_model.h"
 
 namespace fusedet::fusion {
 namespace {

@@ -7,8 +7,8 @@
 #include <opencv2/core.hpp>
 #include <random>
 
-#include "fusedet/fusion/drawing/detections_file.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
+#include "fusedet/fusion/drawing/detections_file.h"
 #include "fusedet/fusion/drawing/mosaic.h"
 
 namespace fs = std::filesystem;

@@ -10,11 +10,11 @@
 #include "fusedet/drivers/lms291/protocol.h"
 #include "fusedet/drivers/lms291/scan_decoder.h"
 #include "fusedet/drivers/lms291/telegram.h"
-#include "fusedet/drivers/log/recorder.h"
 #include "fusedet/drivers/log/candump.h"
+#include "fusedet/drivers/log/recorder.h"
 #include "nod_simulation.h"
-#include "fusedet/fusion/synthesis/frame_encode.h"
 #include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/synthesis/frame_encode.h"
 #include "fusedet/fusion/synthesis/synth_scene.h"
 
 namespace fusedet::fusion {

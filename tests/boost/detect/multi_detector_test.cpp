@@ -3,8 +3,8 @@
 // scanner (Detector::scan(IntegralStack), the path detection took before), on real KITTI stacks
 // fused from ../shared/data with the bundled models: the same hits, scores, order and work.
 
-#include "fusedet/boost/multi_detector.h"
 #include "fusedet/boost/class_detection.h"
+#include "fusedet/boost/multi_detector.h"
 
 #include <gtest/gtest.h>
 

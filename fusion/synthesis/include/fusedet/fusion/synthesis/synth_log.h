@@ -33,8 +33,8 @@
 #include <vector>
 
 #include "fusedet/core/stamp.h"
-#include "fusedet/fusion/camera_model.h"
 #include "fusedet/drivers/canopen/tilt_drive.h"
+#include "fusedet/fusion/camera_model.h"
 
 namespace fusedet::fusion {
 
