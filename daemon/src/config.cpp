@@ -1,4 +1,5 @@
 #include "fusedet/daemon/config.h"
+#include "fusedet/daemon/config_keys.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -19,14 +20,17 @@ namespace {
 // key never silently falls back to a default.
 class Section {
  public:
-  Section(const YAML::Node& node, std::string path, const std::string& source)
-      : node_(node), path_(std::move(path)), source_(source) {
+  // keys: when set, every key path read is appended (configKeys()).
+  Section(const YAML::Node& node, std::string path, const std::string& source,
+          std::vector<std::string>* keys = nullptr)
+      : node_(node), path_(std::move(path)), source_(source), keys_(keys) {
     if (node_ && !node_.IsNull() && !node_.IsMap()) fail(node_, "expected a mapping");
   }
 
   template <class T>
   void read(const char* key, T& out) {
     seen_.insert(key);
+    if (keys_) keys_->push_back(keyPath(key));
     if (!node_ || node_.IsNull()) return;
     const YAML::Node v = node_[key];
     if (!v) return;
@@ -66,6 +70,7 @@ class Section {
   // The entries of the mapping under `key` (name, its section), in file order; marks `key` read.
   std::vector<std::pair<std::string, Section>> entries(const char* key) {
     seen_.insert(key);
+    if (keys_) keys_->push_back(keyPath(key));
     std::vector<std::pair<std::string, Section>> out;
     const YAML::Node n = at(key);
     if (!n || n.IsNull()) return out;
@@ -79,7 +84,7 @@ class Section {
 
   Section child(const char* key) {
     seen_.insert(key);
-    return Section(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), keyPath(key), source_);
+    return Section(node_ && !node_.IsNull() ? node_[key] : YAML::Node(), keyPath(key), source_, keys_);
   }
 
   // Call after all reads: any key not read is unknown.
@@ -128,6 +133,7 @@ class Section {
   YAML::Node node_;
   std::string path_;
   const std::string& source_;
+  std::vector<std::string>* keys_ = nullptr;
   std::set<std::string> seen_;
 };
 
@@ -142,9 +148,9 @@ std::vector<Config::Detection::ClassSettings> Config::Detection::builtInClasses(
 
 namespace {
 
-Config parseTree(const YAML::Node& root, const std::string& source) {
+Config parseTree(const YAML::Node& root, const std::string& source, std::vector<std::string>* keys) {
   Config c;
-  Section top(root, "", source);
+  Section top(root, "", source, keys);
   top.readRange("version", c.version, 1, 1);
   {
     Section s = top.child("log");
@@ -238,9 +244,11 @@ Config parseTree(const YAML::Node& root, const std::string& source) {
     s.readRange("min_neighbors", c.detection.minNeighbors, 0, 1000);
     s.read("laser_extent", c.detection.laserExtent);
     s.readRange("threads", c.detection.threads, 0, 256);
-    if (s.at("classes")) {  // given: replaces the built-in per-class settings (`classes: {}` = none)
+    const bool classesGiven = bool(s.at("classes"));  // replaces the built-in ones (`classes: {}` = none)
+    auto classes = s.entries("classes");
+    if (classesGiven) {
       c.detection.classes.clear();
-      for (auto& [name, e] : s.entries("classes")) {
+      for (auto& [name, e] : classes) {
         Config::Detection::ClassSettings k{name, c.detection.minNeighbors, c.detection.laserExtent};
         e.readRange("min_neighbors", k.minNeighbors, 0, 1000);
         e.read("laser_extent", k.laserExtent);
@@ -289,12 +297,40 @@ Config parseConfig(const std::string& yamlText, const std::string& source) {
     throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax: " + e.msg);
   }
   try {
-    return parseTree(root, source);
+    return parseTree(root, source, nullptr);
   } catch (const YAML::Exception& e) {
     // Every read above turns yaml-cpp's errors into ConfigError; this is the net for a case
     // missed, so that a bad file is a config error (SIGHUP keeps the running config), never a crash.
     throw ConfigError(source + (e.mark.is_null() ? std::string() : ":" + std::to_string(e.mark.line + 1)) + ": " + e.msg);
   }
+}
+
+std::vector<std::string> configKeys() {
+  std::vector<std::string> keys;
+  (void)parseTree(YAML::Node(), "(keys)", &keys);
+  return keys;
+}
+
+const std::vector<std::string>& reloadableConfigKeys() {
+  static const std::vector<std::string> keys{"log.level",           "socket.max_clients",        "socket.max_request_bytes",
+                                             "socket.client_queue", "socket.client_send_buffer", "socket.allow_groups",
+                                             "detection"};
+  return keys;
+}
+
+Config withReloaded(const Config& running, const Config& next) {
+  YAML::Node out = YAML::Load(dumpConfig(running));
+  const YAML::Node in = YAML::Load(dumpConfig(next));
+  for (const std::string& key : reloadableConfigKeys()) {
+    const auto dot = key.find('.');
+    if (dot == std::string::npos) {
+      out[key] = YAML::Clone(in[key]);
+    } else {
+      YAML::Node section = out[key.substr(0, dot)];
+      section[key.substr(dot + 1)] = YAML::Clone(in[key.substr(0, dot)][key.substr(dot + 1)]);
+    }
+  }
+  return parseConfig(YAML::Dump(out), "(reloaded configuration)");
 }
 
 Config loadConfig(const std::filesystem::path& file) {

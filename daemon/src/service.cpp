@@ -6,6 +6,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "fusedet/daemon/config_keys.h"
 #include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/fusion/camera_model.h"
@@ -146,11 +147,15 @@ std::string Service::reload() {
 }
 
 std::string Service::reload(const Config& next) {
+  // The reloadable keys of `next` (config.h reloadableConfigKeys()); what else changed needs a
+  // restart (devices, socket path, fusion geometry).
+  Config applied;
   std::shared_ptr<const StackDetector> detector;
   ServerLimits limits;
   try {
-    limits = serverLimitsFrom(next);  // socket.allow_groups may name a group that does not exist
-    detector = detectorFrom(next, configFile_);
+    applied = withReloaded(config(), next);
+    limits = serverLimitsFrom(applied);  // socket.allow_groups may name a group that does not exist
+    detector = detectorFrom(applied, configFile_);
   } catch (const std::exception& e) {
     std::lock_guard lock(mutex_);
     lastReloadError_ = e.what();
@@ -158,19 +163,13 @@ std::string Service::reload(const Config& next) {
   }
   pipeline_->setDetector(std::move(detector));
   server_->setLimits(limits);
-  spdlog::set_level(spdlog::level::from_str(next.logLevel));
+  spdlog::set_level(spdlog::level::from_str(applied.logLevel));
+  if (dumpConfig(applied) != dumpConfig(next)) {
+    std::string reloadable;
+    for (const std::string& k : reloadableConfigKeys()) reloadable += (reloadable.empty() ? "" : ", ") + k;
+    spdlog::warn("reload: changes outside {} take effect after a restart", reloadable);
+  }
   std::lock_guard lock(mutex_);
-  // What else changed needs a restart (devices, socket path, fusion geometry).
-  Config applied = config_;
-  applied.detection = next.detection;
-  applied.logLevel = next.logLevel;
-  applied.socket.maxClients = next.socket.maxClients;
-  applied.socket.maxRequestBytes = next.socket.maxRequestBytes;
-  applied.socket.clientQueue = next.socket.clientQueue;
-  applied.socket.clientSendBuffer = next.socket.clientSendBuffer;
-  applied.socket.allowGroups = next.socket.allowGroups;
-  if (dumpConfig(applied) != dumpConfig(next))
-    spdlog::warn("reload: changes outside detection, socket limits and log level take effect after a restart");
   config_ = applied;
   lastReloadError_.clear();
   ++reloads_;

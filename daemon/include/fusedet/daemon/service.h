@@ -76,8 +76,8 @@ class Service {
   bool sourcesStopped() const { return sourcesStopped_.load(); }
 
   // Re-reads the config file and the models. Returns "" when applied; else why the old
-  // configuration is kept. Detection settings, models, socket limits and the log level take
-  // effect at once; other changed keys are named in the log as needing a restart.
+  // configuration is kept. The keys of config.h reloadableConfigKeys() (detection settings and
+  // models, socket limits, log level) take effect at once; the log says other changes need a restart.
   std::string reload();
   std::string reload(const Config& next);
 
