@@ -152,7 +152,7 @@ const bool registered = registerCommand(
       app.footer(
           "Every `fusedet experiments` run writes OUT/outcomes.json beside results.json: per class, protocol and "
           "configuration (also each stage-sweep and learning-curve point), each test frame's name, positives and counted detections (score, hit or false "
-          "alarm) - what F and AP are computed from (format: docs/results/README.md, \"outcomes.json\"). "
+          "alarm) - what F and AP are computed from (format: docs/outcomes-format.md). "
           "compare pairs the (class, protocol, configuration) sets present in both runs and, for each, "
           "resamples the frames with replacement once for both runs (paired bootstrap): the 95 % percentile "
           "interval of F_a - F_b and of AP_a - AP_b. Verdict on \"A is better than B\": holds (interval above "

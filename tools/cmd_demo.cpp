@@ -184,7 +184,7 @@ const bool registered = registerCommand(
           "Then runs every model in --models (the bundled models/<class>.json by default) on the stack\n"
           "as fusedetd does with its built-in settings: one pass at scale factor 1.1, step 2, then each\n"
           "class grouped by OpenCV's rule - car with its own settings (16 neighbours, boxes widened to the\n"
-          "laser's object; boost/class_detection.h, docs/results \"Car at IoU 0.7\"), person and bike with\n"
+          "laser's object; boost/class_detection.h, docs/results, \"Options\"), person and bike with\n"
           "3 neighbours and no laser extent (--no-class-detection: every class so). Prints the time of that\n"
           "pass, each class's settings and each detection with the label it matches (IoU >= 0.5), if\n"
           "any. The bundled models are trained on every shared frame, the demo frames included: the\n"

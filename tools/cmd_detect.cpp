@@ -235,7 +235,7 @@ const bool registered = registerCommand(
           "Prints a summary line, the grouping used, then one line per detection (class, score, box in pixels).\n\n"
           "Settings per class: the model's class is grouped as fusedetd groups it (its built-in\n"
           "detection.classes, boost/class_detection.h): car with 16 neighbours and its boxes widened to the\n"
-          "laser's object (docs/results \"Car at IoU 0.7\"), every other class with 3 neighbours and no\n"
+          "laser's object (docs/results, \"Options\"), every other class with 3 neighbours and no\n"
           "laser extent. --min-neighbors and --laser-extent, when given, hold for every class instead of its\n"
           "own value; --no-class-detection gives every class the general settings. The scan (scale factor\n"
           "1.1, step 2) is the same for every class. Car's own settings need the laser: on an --image its\n"

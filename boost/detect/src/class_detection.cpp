@@ -14,7 +14,7 @@ struct OwnDetection {
 
 // The classes with settings of their own. Car: the daemon's scan (ScanParams{}: scale factor 1.1,
 // step 2), more neighbours against the extra windows it accepts, boxes widened to the laser's
-// object (docs/results "Car at IoU 0.7").
+// object (docs/results, "Options").
 const std::vector<OwnDetection>& ownDetections() {
   static const std::vector<OwnDetection> table{{"car", ClassDetection{1.1, 2, 16, true}}};
   return table;

@@ -5,9 +5,9 @@
 // (fusedet experiments).
 //
 // Car's settings were chosen on 3 drive-disjoint folds and confirmed on leave-one-drive-out at the
-// devkit's IoU 0.7 with a paired interval above 0 (docs/results/README.md, "Car at IoU 0.7: method
-// or data"). Person and bike keep the general settings (GroupParams{}, LaserExtentParams{}, the
-// caller's scan): nothing measured beats them.
+// devkit's IoU 0.7 with a paired interval above 0 (docs/results/README.md, "Options": F +0.071
+// [+0.007, +0.138]). Person and bike keep the general settings (GroupParams{}, LaserExtentParams{},
+// the caller's scan): nothing measured beats them.
 
 #include <optional>
 #include <string>

@@ -4,7 +4,7 @@
 // name, its positives and its counted detections (score, hit or false alarm) - everything F and AP
 // are computed from (precision_recall.h), and the matching rule that produced them. Two runs'
 // files compare frame by frame (paired_comparison.h, `fusedet compare`). Only numbers and frame
-// names: no pixels, no labels. Format: docs/results/README.md, "outcomes.json".
+// names: no pixels, no labels. Format: docs/outcomes-format.md.
 
 #include <cstddef>
 #include <filesystem>
