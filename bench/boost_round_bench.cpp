@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // One boosting round (the best regression stump over the whole pool) on the same precomputed
 // feature matrix, three ways in one run with the same thread count:
 //   ours:      8-bit bins per feature (built once per stage), weighted histograms + split scan,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The precomputed feature matrix the boost_round benchmark hands to all three learners.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Calibration: targetless refinement from perturbed starts on KITTI, errors against the calib
 # (timed CLI, not Google Benchmark). Its ctest run is issue 17's acceptance run with the defaults
 # (10 trials, 10 frames, starts 1-2 deg / 5-10 cm off): it prints the error table and exits 1 when a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Targetless laser->camera calibration on real KITTI frames (issue 17's acceptance run): start
 // from the rig's calib perturbed by a random rotation and translation, refine, and measure how far
 // the result is from the calib. Side by side in the same run: the start error (the peer: doing

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sensor-stamp-to-socket latency of the whole daemon replaying a sensor log: a log synthesised
 // from KITTI frames of the last third of drive 0005 (raw LMS telegrams, CANopen tilt traffic, YUYV camera frames) is
 // replayed at recorded speed and re-stamped to "now" (as if the sensors were live) into a running

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Detection engine: our detector vs cv::CascadeClassifier on the same cascade, images and scales,
 # single thread, plus the cost per weak classifier on a 7-layer KITTI-size stack.
 fusedet_bench(bench_detect_vs_opencv SOURCES detect_vs_opencv.cpp

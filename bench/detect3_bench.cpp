@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // All three bundled classes (models/car.json, person.json, bike.json) on one real fused KITTI
 // stack - the frame `fusedet demo` detects on - in one pass (scale factor 1.1, step 2) grouped two
 // ways: every class with the general settings (detect(): OpenCV grouping, 3 neighbours, no laser

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Our detector vs cv::CascadeClassifier::detectMultiScale (the peer) on the same cascade
 // (haarcascade_frontalface_default.xml), the same five photos resized to 640x480, the same scales
 // (factor 1.1, no minimum size), raw candidates (minNeighbors 0), both on one thread

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // HeadlineReporter: Google Benchmark's console output, plus each benchmark's adjusted time kept by
 // name so main() can print the "bench: <key> <value>" headline lines (in the run's time unit).

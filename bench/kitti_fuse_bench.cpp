@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Fusing one KITTI frame (image 1242x375 + ~120k Velodyne points -> 7-layer stack, laser layers at
 // half size) on one core, with a per-step breakdown, against the same pipeline built from stock
 // OpenCV calls, the peer in this run. Equal terms (printed): the peer does exactly our work - the

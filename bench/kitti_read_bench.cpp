@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading one KITTI frame (PNG + 1.9 MB Velodyne + calib + labels) vs the PNG decode alone, the
 // peer that bounds what the frame reader can cost.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Distributed training (docs/distributed.md). bench_mpi_round: one boosting round of the sharded
 # trainer under mpirun -np 1 vs -np 2 (one thread per rank) and the bytes per round; the ctest
 # smoke run uses a small pool on 3 frames per drive.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tracker::update per stack with N objects moving at walking to driving speeds in a 60 x 60 m
 // area around the robot, detected with 0.3 m noise in 90 % of the stacks, plus 10 % clutter; three
 // classes. Peer in the same run: the prediction and gated cost matrices alone (no assignment,

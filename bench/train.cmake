@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Training benchmarks (boost/ training half). bench_boost_round: one boosting round on the issue's
 # reference matrix (OpenCV's default pool on KITTI windows), ours vs XGBoost (hist) vs cv::ml::Boost;
 # the ctest smoke run uses a tiny matrix from 3 frames per drive.

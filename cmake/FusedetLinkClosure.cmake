@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # fusedet_link_closure(<target> <out-var>): every target <target> links, directly or through the
 # targets it links (their LINK_LIBRARIES and INTERFACE_LINK_LIBRARIES, $<LINK_ONLY:> included),
 # sorted. Call it after all targets are defined. Names that are not targets (system libraries,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # The Debian package (docs/packaging.md): `cpack -G DEB` in the build folder, or
 # `cmake --build build --target package`. It holds the install component `runtime` only, staged
 # with DESTDIR under the prefix /usr, so /etc, /lib/systemd/system and /usr/bin are the FHS places

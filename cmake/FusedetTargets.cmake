@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Helpers shared by every folder: one place for warnings, test and benchmark registration.
 
 # Warnings for our own targets (never for third-party headers).

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Runs at install time (install(SCRIPT), component runtime): the files whose place or content
 # depends on the prefix given to `cmake --install --prefix P` or cpack - CMAKE_INSTALL_PREFIX here -
 # rather than the one given at configure time. For the prefix /usr the FHS places apply: the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet calibrate: targetless laser->camera calibration from a few frames of ordinary scenes;
 // writes the config's fusion.laser_to_camera block and before/after overlay PNGs.
 

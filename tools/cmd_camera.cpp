@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet camera: V4L2 cameras.
 //   list          every /dev/videoN: driver, card, capabilities, formats, sizes, frame rates
 //   grab          capture N frames from one device and write them as PNG files

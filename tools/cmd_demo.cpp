@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet demo: the main job on its embedded default - the most complete pipeline that exists,
 // run on the real KITTI frames in ../shared/data: read a frame, fuse it into a layer stack
 // (fusion/), print the stack and the labels, and detect with the bundled models (boost/).

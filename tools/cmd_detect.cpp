@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet detect: run one cascade - ours (model file from `fusedet train`) or an OpenCV Haar
 // cascade XML - on an image or a data-set stack, and print / save / draw the detections.
 

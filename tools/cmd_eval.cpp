@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet eval: a trained cascade (or the AND of several) on the frames of a data set - recall,
 // precision, F-measure, cascade length, weight share per layer (paper Fig. 7), share of corner
 // features and detection time, as a markdown table or JSON.

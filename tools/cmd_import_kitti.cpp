@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet import-kitti: KITTI-layout directories -> the project's data set (docs/dataset-format.md),
 // through the same fusion code as live data.
 

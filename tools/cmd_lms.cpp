@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet lms: talk to a SICK LMS 291 (or lms291-sim) and decode captured telegram streams.
 //   probe DEVICE   find the speed, print type, status and configuration (changes nothing)
 //   stream DEVICE  initialise, stream scans (reconnecting), stop (device back to 9600 baud)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet log: inspect and export MCAP sensor logs (docs/log-format.md).
 //   info LOG                          channels, counts, time span, gaps, damage (where a cut file was cut)
 //   export LOG --candump F | --png DIR | --ply DIR

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet query: a client of fusedetd's socket (docs/protocol.md). Prints the lines the daemon
 // sends, one JSON object per line.
 

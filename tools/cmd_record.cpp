@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet record: record the live sensors into one MCAP sensor log (docs/log-format.md).
 
 #include <atomic>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet replay: a sensor log through fusedetd's pipeline as fast as the machine allows, writing
 // the `detections` lines a subscribed socket client would get (docs/protocol.md), one per stack.
 // The work is daemon/offline_replay.h; this file parses and prints.

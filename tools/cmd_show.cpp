@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet show: a PNG mosaic of one stack's layers with labels and detections drawn (paper Fig. 8),
 // so a person can look at what the detector sees.
 

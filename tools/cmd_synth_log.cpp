@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet synth-log: a realistic raw sensor log from real KITTI frames (or a procedural scene).
 
 #include <chrono>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet tilt: the CANopen CiA 402 tilt motor (or tilt-sim) on SocketCAN, and its simulation.
 //   status    one look at the drive over SDO (changes nothing)
 //   nod       bring the drive up and nod between the configured angles

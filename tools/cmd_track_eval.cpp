@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet track-eval: the tracks of a replayed synthesised KITTI log (`fusedet replay` output)
 // against the drive's KITTI tracking labels - CLEAR MOT, HOTA and detection F of raw detections
 // against confirmed tracks, per class; optionally the tracks-over-time picture. The rules are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet train: trains one class's cascade on a data set (boost/cascade_trainer.h) and writes the
 // model file (boost/model_io.h). Progress: a live status line on a terminal, plain log lines
 // otherwise. Started by mpirun/srun, the ranks share the work (docs/distributed.md): each loads

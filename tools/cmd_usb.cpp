@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet usb: USB devices through libusb.
 //   list [VID:PID[:SERIAL][@PORT]]   devices with their sysfs position, strings and /dev nodes
 //   reset VID:PID[:SERIAL][@PORT]    reset the one matching device (it re-enumerates)

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The `fusedet` command line: one file per subcommand (cmd_<name>.cpp), each registering itself
 // here at start-up, so adding a command touches no shared file.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Where the commands find the shared KITTI data by default: $FUSEDET_DATA, else ../shared/data
 // relative to the working directory (the layout of a checkout beside shared/).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Exit codes of the device commands (`fusedet camera`, `fusedet usb`), so scripts (the
 // real-kernel test tier, udev helpers) can tell a missing device from a refused format.

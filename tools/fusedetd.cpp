@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedetd: the fusedet service - runs the pipeline and serves detections on a Unix socket
 // (docs/protocol.md). Arguments only; the service lives in daemon/ (run.h).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet: the command line of the fusedet perception system (see `fusedet --help`).
 
 #include <spdlog/sinks/stdout_color_sinks.h>

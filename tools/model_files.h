@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Model arguments of the commands: files, or folders whose *.json files are models (sorted).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The options that set how a cascade is trained, defined once for `fusedet train` and `fusedet
 // experiments`: each option's names, help and check, and the boosting::TrainingConfig field it

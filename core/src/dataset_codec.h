@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal to the data set reader/writer: one layer <-> one PNG (quantisation of float layers),
 // strict PNG and file I/O. Facts of the format: docs/dataset-format.md.

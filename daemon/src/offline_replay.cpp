@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/offline_replay.h"
 
 #include <chrono>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/service_parts.h"
 
 #include <spdlog/spdlog.h>

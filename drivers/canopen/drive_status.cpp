@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/drivers/canopen/drive_status.h"
 
 #include "fusedet/drivers/canopen/sdo_client.h"

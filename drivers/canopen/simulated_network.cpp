@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/drivers/canopen/simulated_network.h"
 
 namespace fusedet::drivers::canopen {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/drivers/lms291/scan_assembler.h"
 
 namespace fusedet::drivers::lms291 {

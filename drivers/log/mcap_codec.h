@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Little-endian field codec of MCAP records (internal to drivers/log): ByteWriter appends fields,
 // ByteReader reads them with bounds checks and throws RecordError on any overrun, so a corrupt

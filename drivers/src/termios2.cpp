@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // termios2 (BOTHER) speed setting, kept in its own file because <asm/termbits.h> and the C
 // library's <termios.h> define the same names differently.
 #include <asm/ioctls.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // listFromSysfs / resolveNodeFromSysfs: USB devices as sysfs describes them, without libusb.
 
 #include <algorithm>

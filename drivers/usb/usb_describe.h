@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Internal: one libusb_device as a UsbDeviceInfo (listing and hotplug share it).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/drivers/v4l2/buffer_ring.h"
 
 namespace fusedet::drivers::v4l2 {

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/drivers/v4l2/device_list.h"
 
 #include <linux/videodev2.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // KernelV4l2Io: V4l2Io on a real device node.
 
 #include <fcntl.h>

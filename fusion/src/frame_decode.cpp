@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/fusion/frame_decode.h"
 
 #include <opencv2/imgcodecs.hpp>

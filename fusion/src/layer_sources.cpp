@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/fusion/layer_sources.h"
 
 #include "fusedet/core/layer_stack.h"

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -DCLOSURE=<file> -DTARGET=<name> -DREQUIRED=<a;b> -DFORBIDDEN=<c;d> -P check_link_closure.cmake
 # Fails unless the link closure written at configure time (fusedet_link_closure) holds every
 # REQUIRED target and no FORBIDDEN one; prints the closure.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # cmake -DTABLE=<file> -P check_part_includes.cmake
 # TABLE (written at configure time by tests/boost/CMakeLists.txt) sets PARTS, and per part P
 # FILES_P (its sources and headers) and LINKS_P (the targets it links, directly or not) and

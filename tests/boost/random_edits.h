@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Fuzz-style parser tests: a valid file with 1-4 random edits - a byte replaced by any value, a
 // run of up to 8 bytes deleted, one of `tokens` inserted, or the rest cut off - never empty.

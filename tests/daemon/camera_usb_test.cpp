@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // camera.usb: CameraSource names its camera by USB id against a fake sysfs tree (the kernel's
 // layout: /sys/bus/usb/devices/<port> -> the device, <port>:1.0/video4linux/videoN). The id is
 // looked up before every open, an absent camera is reported by its id, and a camera re-plugged

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The systemd units as configured for installation: `systemd-analyze verify` must be silent and
 # `systemd-analyze security --offline=true` must rate fusedetd.service at exposure <= 2.5.
 # ExecStart points at the build tree's fusedetd so that verify can check the binary.

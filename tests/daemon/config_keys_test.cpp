@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Each daemon config key is declared once in effect: the keys parseConfig() reads (configKeys()),
 // the keys dumpConfig() writes and the keys config/fusedet.yaml documents are one set, the
 // documented values are the defaults, and the reload list (reloadableConfigKeys()) is the one the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/rig.h"
 

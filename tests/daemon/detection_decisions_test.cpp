@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The bundled models' decisions, pinned: every model of models/ run as fusedetd runs it - the
 // shipped config/fusedet.yaml's detection section (scan, grouping, per-class settings: car with its
 // own neighbours and laser extent) through daemon::CascadeSet, then each detection's 3D position

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedetd as a process, the way systemd runs it, replaying a synthesised sensor log (the live
 // devices of the config do not exist): READY=1 / STATUS= / WATCHDOG=1 / STOPPING=1 on a test
 // NOTIFY_SOCKET, SIGHUP reload with a bad and then a good file while a subscribed client keeps

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // KITTI frames as recorded scenes for SceneSource (Velodyne turn + camera image, each a 0.1 s
 // sweep) and the Fuser for their calibration: the whole daemon on real data without devices

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pipeline fuses a sweep as soon as a tilt sample closes it (SweepAssembler closeOnTilt):
 // the fusion thread takes sweeps after every message, tilt samples included, so the stack does
 // not wait for the next stroke's first scan. Streams from a triangle tilt profile written here.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Unit tests of the daemon's small parts: the drop-oldest queue, the meters, the request parser
 // (with garbage input) and 3D localization from the distance layer.
 

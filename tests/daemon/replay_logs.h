@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Sensor logs for the daemon tests: synthesised at run time by the synth-log library from the
 // KITTI frames (last third of drive 0005) in ../shared/data (procedural scene when there is no KITTI data) and kept

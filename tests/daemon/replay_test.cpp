@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The daemon replaying a sensor log (synthesised from KITTI frames of the last third of drive 0005; procedural without
 // KITTI data) through its real pipeline - live decoders, sweep assembly, pairing, fusion, the
 // bundled cascades, the socket server: deterministic as-fast-as-possible replays, 50 mixed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SceneSource: plays a list of recorded scenes (sweep + camera frame pairs) into the pipeline at
 // a fixed period, as a sensor would: each scene is stamped with the time it is emitted (the

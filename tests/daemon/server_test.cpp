@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The socket server under hostile and mixed clients, fed with synthetic stack results at a steady
 // rate (no detection cost, so the test is about the server): 50 clients at once - normal,
 // class-filtered, slow, silent, malformed, oversized and flapping. Clients that keep up must get

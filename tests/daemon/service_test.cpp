@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The whole daemon in-process on real KITTI scenes: scene source -> fusion -> the bundled
 // cascades -> socket clients. Checks what clients receive (every stack, positions that agree with
 // KITTI's own 3D labels), reload under load (replaying a sensor log), liveness for the watchdog

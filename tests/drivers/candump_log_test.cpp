@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The candump -l log format: vectors written by hand from can-utils' format, round trips,
 // bad lines with clear errors, and a fuzz run of the reader.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CAN frames, error-frame texts, the in-process bus and the SocketCAN parts that need no kernel
 // CAN support (frame conversion, clear errors for missing or non-CAN interfaces).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CANopen facts from design.md §3 (bytes written out by hand here, not by the encoder under
 // test) and the SDO client against scripted server responses: expedited, segmented with
 // toggles, abort codes, timeouts.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The expected range of the LMS simulator's default scene, computed independently of the
 // simulator: side walls at x = +-3 m, front wall at y = 5 m, a post of radius 0.2 m at (0.5, 2.0);

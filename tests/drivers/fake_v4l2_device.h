@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // FakeV4l2Device: a V4L2 capture device in memory behind the V4l2Io interface, written from the
 // kernel's API documentation and sharing no code with the driver (it never calls the driver's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Protocol contents: baud codes and words, count word, telegram sizes per variant, status
 // offsets, special distance codes, interlaced merging (§3, §4 of the fact sheet).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // lms291-sim --log: the simulator streams a synthesised log's scans (re-encoded by its own
 // encoder) and the live driver on the pty reads exactly those scans, in order, looping at the end;
 // a driver asking for another scan mode than the log's is refused.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The LMS 291 driver against lms291's simulator on a pseudo-terminal: initialisation from every
 // start speed, lossless streaming, corruption, NAKs, vanish/reappear, stop back to 9600.
 // Every scan is checked against the room geometry computed here, independently of the scene code.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Telegram layer: every vector of the protocol fact sheet (../shared/docs/lms291-protocol.md §1),
 // the reader's framing, ACK/NAK and resynchronisation, and fuzz-style robustness.
 

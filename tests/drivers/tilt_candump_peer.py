@@ -1,4 +1,5 @@
 #!/usr/bin/python3
+# SPDX-License-Identifier: Apache-2.0
 """Independent peers for the candump logs fusedet writes (shares no code with the driver).
 
 1. python-can (Debian python3-can) reads the log with can.CanutilsLogReader.

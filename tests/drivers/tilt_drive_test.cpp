@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The tilt drive (CANopen master) against the CiA 402 motor simulator on an in-process bus with
 // simulated time: start-up from boot-up to operation enabled, 10 nodding sweeps compared with an
 // independent trapezoid model of the commanded profile, and every fault injected and recovered

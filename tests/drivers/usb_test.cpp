@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // USB: VID:PID[:SERIAL] parsing (with fuzzing), resolution of a device to its /dev nodes on a fake
 // sysfs tree laid out as the kernel does for an FTDI adapter, a UVC camera behind a hub and a
 // CDC-ACM device, and picking exactly one device. libusb itself needs a USB bus: the real-kernel tier.

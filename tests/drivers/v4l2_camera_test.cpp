@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // V4l2Camera and FrameStream against FakeV4l2Device (an in-memory V4L2 device written from the
 // kernel API, sharing no code with the driver), and the kernel I/O layer's error paths on nodes
 // that need no camera (a missing path, a regular file, /dev/null).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The V4L2 driver's pure logic: format negotiation, buffer bookkeeping, sequence-gap counting,
 // stall escalation and the exposure/gain plan. No device, no ioctl.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pieces under the calibrations: Nelder-Mead, the rpy convention's inverse, the extrinsics
 // file, and the KITTI calibration input.
 

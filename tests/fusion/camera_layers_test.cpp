@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The hue layer's mask (fusion/camera_layers.h) on hand-made pixels with known answers.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera model files, undistortion against a distortion applied here with the Brown-Conrady
 // formulas (as OpenCV documents them), and the extrinsics convention.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera frame decoding, frame pairing, camera layers (hue, hue distance across the wrap).
 
 #include <gtest/gtest.h>

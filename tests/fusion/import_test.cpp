@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // KITTI import end to end (fuse -> data set -> read back), the detections file, the mosaic.
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Raw drives from SOURCE.md: a hand-written example of both forms, garbage, and the shared data's
 // own files (their counts are stated in those files).
 

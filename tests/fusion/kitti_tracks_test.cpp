@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Which physical object a KITTI tracking label is: a hand-written file, garbage, and the shared
 // drive 0005, whose SOURCE.md states that its cyclist is one track in every frame.
 

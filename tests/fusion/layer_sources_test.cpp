@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Layer sources (fusion/layer_sources.h): every paper pool layer has a source, and
 // weight shares sum per source.
 #include <gtest/gtest.h>

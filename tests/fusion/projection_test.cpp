@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Projection and laser layers, checked against computations written here from the KITTI
 // definition x = P2 * R0_rect * Tr_velo_to_cam * X (Geiger et al., IJRR 2013).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sweep assembly on synthetic geometry: a nodding scanner in front of a wall at a known distance,
 // with ranges ray-cast here (own rotation matrix, own ray-plane intersection).
 

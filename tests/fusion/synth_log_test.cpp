@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Logs synthesised by synth-log, replayed the way the daemon replays them: the log's own rig
 // (metadata fusedet.config) configures the live decoders (SensorReplay), the sweep assembly,
 // frame pairing and the Fuser. The KITTI log's distance layers are compared with the direct

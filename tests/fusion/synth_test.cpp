@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parts of synth-log: ray casting into a point cloud, YUYV encoding (checked
 // through the independent OpenCV decoder decodeCameraFrame uses), the procedural scene.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a fusedetd config file (config/fusedet.yaml's keys). parseConfig may only
 // return a Config or throw ConfigError (what --check-config and SIGHUP report); any other
 // exception, crash or hang is a finding. An accepted config must survive its own dump.

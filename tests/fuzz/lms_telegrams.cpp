@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: the LMS 291 serial byte stream - framing, resynchronisation after garbage,
 // ACK/NAK bytes, CRC - as TelegramReader takes it from the port, cut into reads as the input's
 // first byte says, and every telegram it yields decoded as the driver would (measured values,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: an MCAP sensor log (docs/log-format.md) as McapReader reads a file: the
 // input is put in an anonymous memory file and opened by path; the index pass and every message
 // the cursor yields. McapError is the only exception allowed (a file that is not MCAP).

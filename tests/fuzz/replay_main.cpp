@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The corpus replayer of a fuzz target for the ordinary build (no libFuzzer): runs
 // LLVMFuzzerTestOneInput once on every file of the directories (or files) given, in name order,
 // so that the suite replays each target's corpus and no finding comes back. Prints the count.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: one request line from a socket client (docs/protocol.md) as the server takes
 // it: parsed, and the reply to a bad one encoded with the request's id. Only a clean return is
 // allowed: bad input is an error line, never an exception or a crash.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Peer check: MRPT's LMS 2xx driver (mrpt::hwdrivers::CSickLaserSerial, Debian
 // libmrpt-hwdrivers-dev) reads scans from our lms291-sim over a pseudo-terminal at 38400 baud.
 // It runs its own set-up (baud probing and switch, installation mode, config read/write,

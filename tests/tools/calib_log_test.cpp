@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Calibration input from a sensor log (fusedet calibrate --log): a synthesised log of a procedural
 // scene, whose rig (SynthRig) is known here independently of the log's metadata, replayed into
 // calibration frames; targetless calibration from perturbed starts must come back to the rig.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The Debian package as cpack builds it from this build tree (docs/packaging.md): the files a
 # robot needs in their FHS places and nothing of the development tree, /etc/fusedet/fusedet.yaml
 # as the one conffile, dependencies computed by dpkg-shlibdeps, Debian-style maintainer scripts,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `fusedet demo` and `fusedet detect` detect as fusedetd does: car grouped with its own settings
 // (boost/class_detection.h) on a real KITTI frame. The expected detections are computed here with
 // detectPerClass() and a car grouping built in this test from classDetectionDefault("car") - not

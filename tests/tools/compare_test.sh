@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # `fusedet compare` as a user runs it.
 #   compare_test.sh FUSEDET WORKDIR             hand-written outcomes files: the table, --json, refusals
 #   compare_test.sh FUSEDET WORKDIR QUICK_OUT   the quick experiments run against itself: F and AP equal

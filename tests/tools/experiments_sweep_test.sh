@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # `fusedet experiments --stage-sweep` on the quick run's cached fold models (no training): the
 # sweep point with every stage and the run's min neighbours must give exactly the `all` row's
 # hits / false alarms / misses (the cut is the identity there), a 1-stage cut must change them,

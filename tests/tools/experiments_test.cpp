@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `fusedet experiments` helpers: the split, the class rules and counts (checked against the counts
 // the data set's SOURCE.md states), the peers on a real frame, and the report writers.
 

@@ -1,4 +1,5 @@
 #!/bin/bash
+# SPDX-License-Identifier: Apache-2.0
 # `fusedet --help` lists each subcommand in exactly one line (name + one-line description), and each
 # listed subcommand's own --help works and explains more than that line. Usage: help_test.sh FUSEDET
 set -u

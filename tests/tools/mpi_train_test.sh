@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # `mpirun fusedet train` end to end on a small synthetic data set (docs/distributed.md).
 #   mpi_train_test.sh MODE FUSEDET WRITER MPIRUN WORKDIR
 # identity:     1, 2 and 3 ranks write byte-identical models; only rank 0 prints; without mpirun

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // assign() against brute force over every partial matching, on worked examples and random
 // matrices with forbidden pairs.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // ConstantVelocityKalman against worked examples computed by hand (one axis: the axes are
 // independent, so every axis shows the same numbers).
 #include <gtest/gtest.h>

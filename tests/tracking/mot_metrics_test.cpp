@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // CLEAR MOT and HOTA of the tracking library against worked examples and against an independent
 // implementation written here from the papers' definitions (brute-force matching, no code shared
 // with the library), on random sequences.

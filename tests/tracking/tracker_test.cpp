@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The track manager: M-of-N birth, death after the miss budget or the coast time, ids never
 // repeated, association per class, gaps, dropped stacks and stamps shifted as a replay shifts them.
 #include <gtest/gtest.h>

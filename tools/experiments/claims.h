@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Measures with bootstrap intervals, the paper's claims judged by paired comparison, the goals.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet experiments: registers the command (options.h defines its options, run.h runs it).
 
 #include <memory>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The data of one run: KITTI drives found and imported once, their raw drives, object ids and items.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The options of `fusedet experiments`: what they hold, their command-line definition, and the
 // training, detection and plan they give (the preset with the options applied).

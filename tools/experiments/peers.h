@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Camera-only peers for the person class, run on the same test frames as our cascades:
 // OpenCV's HOG people detector (Dalal-Triggs SVM, HOGDescriptor::getDefaultPeopleDetector) and

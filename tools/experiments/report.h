@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `fusedet experiments`, output side: report.md (cross-drive tables with 95 % bootstrap intervals,
 // the paper's claims judged with paired intervals, learning curves, goals), results.json, and the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // fusedet experiments: the paper's experiments (Tab. 2-7, Fig. 7) validated across drives with one
 // command - per class and configuration (layer / feature subsets, the AND combination), cascades
 // trained per fold on the other drives and tested on the held-out drive, pooled over folds: F, AP

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One `fusedet experiments` run: folds, configurations, sweep, learning curves, models; writes the
 // report after every step.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Short texts of numbers and lists shared by the experiments' output.
 

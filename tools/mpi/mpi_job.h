@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A training job's ranks over MPI, for tools that train (fusedet train, bench_mpi_round).
 //

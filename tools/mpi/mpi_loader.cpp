@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Finds and loads libfusedet_mpi.so (mpi_job.h): only here does fusedet touch the dynamic loader.
 #include <dlfcn.h>
 

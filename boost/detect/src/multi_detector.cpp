@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/multi_detector.h"
 
 #include "fusedet/boost/class_detection.h"

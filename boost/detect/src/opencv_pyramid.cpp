@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "opencv_pyramid.h"
 
 #include "fusedet/boost/opencv_cascade.h"

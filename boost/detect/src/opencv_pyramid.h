@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scanning of imported OpenCV Haar cascades the way cv::CascadeClassifier::detectMultiScale does
 // (OpenCV 4 cascadedetect): the 8-bit layer is resized per scale (INTER_LINEAR_EXACT), integrated

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A small, strict reader for the XML subset OpenCV's FileStorage writes (elements, attributes,
 // text, comments, the <?xml ?> declaration, the five predefined entities). Bounded nesting depth;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/negative_miner.h"
 
 #include <tbb/blocked_range.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/training_set.h"
 
 #include <opencv2/core.hpp>

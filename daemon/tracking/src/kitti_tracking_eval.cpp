@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/tracking/kitti_tracking_eval.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // tilt-sim: the CiA 402 motor simulator on a SocketCAN interface (see --help).
 
 #include <CLI/CLI.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MotionProfile: the simulated drive's trajectory generator for profile position mode. Moves
 // toward a target with a trapezoidal velocity profile: accelerate at most `accel`, cruise at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MotorSimulator: a CiA 402 servo drive with a CiA 301 CANopen interface, as one CanNode.
 //  - NMT slave: boot-up message after power-on / reset, pre-operational, operational, stopped;

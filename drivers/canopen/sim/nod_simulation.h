@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // runNodSimulation: the tilt drive and the motor simulator on an in-process bus with simulated
 // time, nodding for a number of sweeps, all traffic written as a candump log (what

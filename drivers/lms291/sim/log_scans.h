@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The laser scans of a sensor log (docs/log-format.md), for `lms291-sim --log`: the log's raw
 // serial channel read through logs::SensorReplay (the driver's telegram reader and scan

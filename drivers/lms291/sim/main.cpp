@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // lms291-sim: a SICK LMS 291 on a pseudo-terminal, for tests, peers and demos without hardware.
 // Prints "lms291-sim: device <pty>" once the device is up, runs until SIGINT/SIGTERM or
 // --duration, then prints its counters as one JSON line.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scene for the LMS 291 simulator: a rectangular room seen from a scanner on the back wall's
 // axis, with round posts. The scanner looks along +y; beam angles run counter-clockwise from

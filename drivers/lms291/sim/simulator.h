@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Simulator: a SICK LMS 291 on a pseudo-terminal. The host (a driver) opens the pty's slave
 // side (or the symlink `link`); the simulator plays the device on the master side.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The agreement measures of targetless calibration (see calib_targetless.h) at one pyramid level:
 // the points are chosen and prepared once, then any transform is scored quickly.

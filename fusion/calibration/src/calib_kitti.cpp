@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/fusion/calibration/calib_kitti.h"
 
 #include <opencv2/imgcodecs.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Leave-one-out (jackknife) spread of a pose estimate, used as the calibrations' uncertainty.
 

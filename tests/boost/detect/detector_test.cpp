@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scanner (precomputed per-scale offsets, threads) against the obvious per-window path, and
 // cascade validation.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Features a-j against a pixel-by-pixel computation of mean(black) - mean(white), integral images
 // against brute-force sums, and layers of different resolutions.
 

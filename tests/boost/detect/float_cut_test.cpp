@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // floatCut(): v < cut exactly when static_cast<float>(v) < threshold. Checked with the compiler's
 // own double -> float rounding on the doubles next to each cut and on random doubles around it,
 // for ordinary, subnormal, zero, extreme and infinite thresholds.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Grouping against its peer (cv::groupRectangles on the same rectangles); and the
 // integral images of the OpenCV path against cv::integral.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MultiDetector (all classes in one pass: shared interleaved integrals, breadth-first AVX2 scanner,
 // threads) against each class's own Detector on per-class integrals with the one-window scalar
 // scanner (Detector::scan(IntegralStack), the path detection took before), on real KITTI stacks

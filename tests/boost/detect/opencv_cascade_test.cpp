@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OpenCV Haar XML import: a hand-written cascade read back field by field, every shipped
 // stump cascade loads, bad files fail with the file name and the problem, and a fuzz run over
 // mutated files never crashes or hangs.

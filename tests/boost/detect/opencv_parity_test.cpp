@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Parity with cv::CascadeClassifier (the peer): nine cascades on real photos (opencv-doc's
 // examples) and KITTI frames. Per image, our raw accepted windows must be exactly OpenCV's raw
 // candidates (minNeighbors 0) as sets - not a share of all windows scanned, which a scanner that

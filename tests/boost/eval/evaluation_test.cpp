@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Matching detections to labels: hand-checked boxes whose IoU / coverage is worked out in the
 // comments, and the F-measure checked against the paper's own table values.
 

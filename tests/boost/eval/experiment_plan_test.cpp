@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The presets of `fusedet experiments` (experiment_plan.h): "bundled" must train the way the bundled
 // models were trained - checked against what models/*.json record about their own training, not
 // against numbers copied into this test - and the plan's rules (which configurations run for which

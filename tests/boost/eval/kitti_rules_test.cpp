@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The KITTI devkit's 2D rules, average precision, bootstrap intervals and the split rules, on
 // worked examples whose answers are computed by hand in the comments.
 

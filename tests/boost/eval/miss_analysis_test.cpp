@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where missed objects are lost (miss_analysis.h), on a synthetic scene whose every object is
 // built to be lost at one known step, and the grouping fates it relies on (grouping.h).
 

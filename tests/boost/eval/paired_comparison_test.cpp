@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Paired comparisons of two runs (boost/paired_comparison.h) and their outcomes.json files
 // (boost/outcomes_file.h) on small outcomes whose F and AP are worked out by hand in the comments.
 

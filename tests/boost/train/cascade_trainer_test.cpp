@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/cascade_trainer.h"
 
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Incremental negative mining (negative_miner.h) against the full rescan it replaces
 // (TrainingStacks::harvestNegatives(): every window of every stack scanned with the whole cascade
 // by Detector::scan(IntegralStack)), on real KITTI stacks fused from ../shared/data: the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sharded training (collective.h, sharded_samples.h, sharded_stage.h) without MPI: ranks are
 // threads joined by an in-process Collective that shares no code with the MPI module. Each rank
 // gets only its own items' pixels; the results must not depend on the number of ranks.

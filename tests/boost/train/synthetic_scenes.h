@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Synthetic training scenes shared by the trainer tests and the dataset writer of the MPI tests.
 

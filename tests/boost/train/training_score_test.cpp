@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The training score of cross-drive validation (ChainSpec::scoreTrainingItems) on synthetic
 // scenes: every fold's cascade run on its own training items, checked against a cascade trained
 // here on the same items and a matching written here (greedy by score, IoU >= 0.5, no ignore

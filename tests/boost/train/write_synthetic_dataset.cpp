@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // write_synthetic_dataset DIR [N]: the trainer tests' synthetic scenes (synthetic_scenes.h) as a
 // data set (core/dataset.h), so command-line tests can train on them.
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sensor-log channels: base64 vectors (RFC 4648 §10), JSON codecs round trip, malformed input,
 // and the Recorder writing a readable log from several threads.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Independent check of a derived log against Foxglove's own published schema definitions: the JSON
 // Schemas of @foxglove/schemas (npm, the package Foxglove generates from its schema sources),
 // validated with Ajv. @mcap/core reads the file through its summary and indexes.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs @foxglove/schemas, ajv, @mcap/core and fzstd from npm into CACHE once. Validates every
 # message of the sample log (every channel kind, a detection box, an MJPEG frame) against
 # Foxglove's published schemas; synthesises a log with the derived channels (fusedet synth-log

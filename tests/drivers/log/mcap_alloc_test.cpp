@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The MCAP reader's memory on a corrupt log (issue 37): a chunk header may claim any
 // uncompressed size up to the reader's 1 GiB plausibility limit. The reader used to allocate
 // the claimed size before decompressing; a 2 kB file could cost 1 GiB. This binary replaces

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Independent reader check: @mcap/core (Foxglove's TypeScript MCAP library, from npm) reads a
 // fusedet log twice - sequentially (McapStreamReader, chunk CRCs validated) and through the
 // summary and indexes (McapIndexedReader) - and compares channels, counts and contents with

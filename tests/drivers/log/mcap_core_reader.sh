@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs @mcap/core and fzstd (a pure-JS zstd decoder) from npm into CACHE once, writes the
 # sample log and lets the independent reader check it. Usage: mcap_core_reader.sh WRITER CACHE WORKDIR
 set -euo pipefail

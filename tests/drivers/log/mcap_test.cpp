@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MCAP writer and reader: round trip, chunking, time order, indexes and summary as bytes,
 // damage (CRC, truncation at every offset), fuzzing. Expected values come from what the test
 // wrote, and the summary layout is checked byte by byte against the spec's field order.

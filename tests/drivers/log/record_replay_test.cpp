@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Recording hook end to end: the LMS 291 driver streams from lms291-sim (on a pty) while a
 // Recorder takes its raw reads (ScanStream::setRecorder) and the scans the live driver decoded;
 // replaying the raw bytes through the same decoders must give back exactly those scans -

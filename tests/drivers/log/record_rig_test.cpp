@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Recording beyond the laser: one Recorder takes, at the same time,
 //  - the LMS 291 driver's raw serial reads (ScanStream::setRecorder) streaming from lms291-sim on
 //    a pty,

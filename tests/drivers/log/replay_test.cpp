@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Replay: a log recorded from known telegrams, CAN frames and camera buffers comes back through
 // the live decoders with the values and stamps that went in; pacing, determinism, stop, and a
 // cut log replaying up to its last complete chunk.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes a sensor log with known content through logs::Recorder (every channel kind, several
 // chunks) and prints what it wrote as JSON, so an independent reader (mcap_core_reader.cjs,
 // @mcap/core from npm) can check the file against the writer's intent, not against our reader.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/experiments/experiment_plan.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "fusedet/sensor_logs/log_export.h"
 
 #include <cerrno>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Box: an axis-aligned rectangle (x, y = top-left corner). Used in pixels and in unit-square
 // coordinates (paper eq. 1), the unit depending on the context the box lives in.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CPU-time clocks, beside Stamp's wall clock (stamp.h): stage timings and benchmarks report CPU
 // time next to wall time, since on a shared machine wall time also counts waiting for a core.

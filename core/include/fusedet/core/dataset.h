@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The project's data set format: a directory of layer stacks + labels that fusion writes (KITTI
 // import, recorded logs) and boost reads (training, evaluation, experiments). Files are ones

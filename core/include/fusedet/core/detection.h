@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Detection: one object found in one LayerStack, as the detector reports it and the daemon sends it.
 

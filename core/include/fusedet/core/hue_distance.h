@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Hue distance (paper §3.1): the angular distance between each pixel's hue and a class's
 // reference hue, so that hue, an angle, becomes a totally ordered value a Haar feature can use.

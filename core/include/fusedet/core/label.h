@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Label: a ground-truth box of a data set stack. Ignore regions (KITTI DontCare, classes
 // configured as "ignore") are labels with `ignore` set: matching them is neither a hit nor a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // LayerStack: named, registered 2D sensor layers of one scene (paper §3.1). Each layer keeps its
 // own resolution; all are addressed in unit-square coordinates (x / w_l, y / h_l, paper eq. 1),

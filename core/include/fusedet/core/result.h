@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Result<T>: value or Error, for routine failures (timeouts, CRC errors, ENODEV) that a
 // reconnecting driver handles without unwinding. Member names follow std::expected so the alias

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stamp: a CLOCK_MONOTONIC time point in nanoseconds, the one clock every message in fusedet uses.
 

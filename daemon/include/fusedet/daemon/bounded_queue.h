@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // BoundedQueue: a small multi-producer, single-consumer queue between pipeline threads. push()
 // never blocks: when the queue is full the OLDEST item is dropped and counted, because for a robot

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CameraSource: the live V4L2 camera as a pipeline source. The driver's FrameStream owns the
 // thread, restarts stalled streams and reopens vanished devices; each frame goes to the sink,

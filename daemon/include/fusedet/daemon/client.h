@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Client: the client side of the socket protocol (docs/protocol.md) - connect, send a request,
 // read reply lines. Used by `fusedet query` and the tests.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Config: the daemon's one YAML file (config/fusedet.yaml documents every key and default).
 // Loading is strict: unknown keys, wrong types and out-of-range values are errors that name the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The daemon's config keys as lists, so that parse, dump, the reload list and the documented YAML
 // (config/fusedet.yaml) cannot drift apart: tests/daemon/config_keys_test.cpp checks them equal.

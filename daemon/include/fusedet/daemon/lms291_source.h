@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Lms291Source: the live SICK LMS 291 as a pipeline source. The driver's ScanStream owns the
 // thread and reconnects on its own; each scan is handed to the sink, which never blocks.

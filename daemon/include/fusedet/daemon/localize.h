@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Localize: the 3D position of a detection from the distance layer inside its box. Background
 // cells (behind the object) and filled holes would pull a mean away, so the range is a low

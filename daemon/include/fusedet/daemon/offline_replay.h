@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Offline replay: a sensor log through the daemon's own pipeline (replayParts + Pipeline, exactly
 // what fusedetd runs with replay.file set) as fast as the machine allows, without dropping a

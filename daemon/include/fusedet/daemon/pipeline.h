@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Pipeline: sensor messages -> sweep assembly -> pairing -> fusion (fusion thread) -> every class
 // (detection thread) -> 3D positions -> tracks (tracking::Tracker, detection thread) -> StackResult handed to a callback (the socket server). Sources run on their

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The socket protocol's messages (docs/protocol.md): one JSON object per line in each direction.
 // Requests carry "cmd" (hello | subscribe | unsubscribe | latest | status) and an optional "id"

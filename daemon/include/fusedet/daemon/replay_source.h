@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ReplaySource: a sensor log (docs/log-format.md) replayed into the pipeline as the sensors would
 // deliver it - raw LMS bytes, CAN frames and camera buffers through the live decoders

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The sensor rig a Config describes, as the settings of the drivers, the log replay and the
 // fusion: one mapping from config keys to library settings, for live mode and for replaying a

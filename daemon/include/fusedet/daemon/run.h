@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // runDaemon: fusedetd's life under systemd (or by hand): socket activation (sd_listen_fds) or
 // binding the configured path, READY=1 once requests are served, STATUS= whenever the summary

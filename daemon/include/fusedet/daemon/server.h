@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Server: the Unix stream socket clients talk NDJSON on (docs/protocol.md), one epoll thread.
 // publish() is called by the detection thread and only queues (never blocks); each client has a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Service: the running daemon - sources, pipeline and socket server wired together, with the
 // answers to `hello` and `status`, reload (SIGHUP) and the liveness the systemd watchdog is fed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The parts of a Service a config asks for: live devices (laser, tilt, camera) or, when
 // `replay.file` is set, a sensor log replayed through the same pipeline with the log's own rig

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Source: one sensor input of the pipeline on its own thread - a live device driver (LMS 291,
 // tilt motor, camera) or a replay of recorded data (a sensor log, recorded scenes). A source

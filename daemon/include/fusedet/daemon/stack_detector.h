@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // StackDetector: the pipeline's one, narrow detection call - every configured class on one
 // LayerStack. CascadeSet implements it with boosting::MultiDetector: all model files in one pass

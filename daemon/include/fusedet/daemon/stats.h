@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Small thread-safe meters for `status`: event rates over a sliding window and latency
 // percentiles over the most recent samples.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Thread names and CPU times: the daemon's threads carry names (visible in `top -H`, `ps -L`,
 // perf) and its stage timings report CPU time beside wall time, since on a shared machine wall

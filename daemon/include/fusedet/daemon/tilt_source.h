@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // TiltSource: the live CANopen tilt motor as a pipeline source. Its thread opens the SocketCAN
 // interface, starts the nodding drive (drivers::canopen::TiltDrive, which recovers from drive

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Sensor messages: what the drivers emit and what fusion and the logs consume. Plain data;
 // every stamp is CLOCK_MONOTONIC, taken as close to the hardware as possible.

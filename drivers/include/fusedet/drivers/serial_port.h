@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SerialPort: a raw 8N1 serial line (termios) with poll-based timeouts. Speeds the C library
 // knows go through cfsetspeed; others, or any speed the port refuses that way, through the

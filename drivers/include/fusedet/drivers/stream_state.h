@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // StreamState: what a reconnecting device thread (lms291::ScanStream, v4l2::FrameStream) is doing,
 // for the daemon's status.

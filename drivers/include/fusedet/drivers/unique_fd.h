@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // UniqueFd: sole owner of a file descriptor, closed on destruction (libcamera's UniqueFD idea).
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Camera layers of a stack (paper §3.1): red, green, blue, intensity (8-bit, full resolution) and
 // hue (float degrees). hue_distance is per class and derived later (core/hue_distance.h).

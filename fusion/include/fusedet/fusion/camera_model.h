@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Camera model: pinhole K plus OpenCV distortion coefficients (design §4), read from a ROS
 // camera_info YAML or an OpenCV calibration YAML, and the laser->camera extrinsics from config.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CameraFrame (raw bytes as the V4L2 driver captured them) -> 8-bit BGR image.
 

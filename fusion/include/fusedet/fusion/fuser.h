@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Fuser: one camera image + one sweep -> a LayerStack with the camera layers (red, green, blue,
 // intensity, hue) at image resolution and the laser layers (distance, remission, with a validity

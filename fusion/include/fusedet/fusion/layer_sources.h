@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which sensor a layer of the joint feature pool comes from, so a cascade's weight share per layer
 // can be summed per source: what each sensor contributes (issue 15).

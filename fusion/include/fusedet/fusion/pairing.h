@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Pairing of a sweep with the camera frame nearest to the sweep's middle (design §4), within a
 // configured skew; frames wait in a small buffer until their sweep is complete.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Projection of a sweep into the (undistorted) camera image plane and rasterisation into the
 // laser layers `distance` and `remission` at their own, lower resolution (paper §3.1, design §4):

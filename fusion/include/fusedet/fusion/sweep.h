@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Sweep: the 3D points of one tilt sweep of the nodding laser (or one Velodyne turn in KITTI).
 

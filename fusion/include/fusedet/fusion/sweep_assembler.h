@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SweepAssembler: LaserScan + TiltSample streams of a nodding SICK LMS -> 3D sweeps (design §4).
 //

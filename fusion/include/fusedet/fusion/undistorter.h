@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Undistortion of camera images with remap tables computed once per camera model (paper §3.1:
 // barrel distortion correction). The undistorted image keeps the model's K, so laser points

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Detection settings that differ by class. One pass of MultiDetector scans every class with one
 // ScanParams; what follows the scan - the grouping's minimum of neighbours and the laser-extent box

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What one detection runs with, after the model: the scan, the grouping and what follows it (the
 // laser extent). The per-class settings (class_detection.h) and the evaluation loop

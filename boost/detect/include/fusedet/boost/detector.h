@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Detector: runs one Cascade over every window of a LayerStack (positions x scales) with early
 // exit, returning raw hits; grouping.h turns hits into Detections.

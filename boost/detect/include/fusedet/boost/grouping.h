@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // From raw window hits to detections by cv::groupRectangles' rule: hits whose four edges lie within
 // eps * mean(min width, min height) / 2 of each other are linked, linked sets form groups

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // IntegralGrids: the summed-area tables of every layer that a set of models reads, built in one
 // pass over a stack and shared by all of them (internal to boost/, used by window_scanner.h).

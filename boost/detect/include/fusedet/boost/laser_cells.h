@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A stack's `distance` layer read in boxes given in the stack's reference pixels: the one place
 // that says which laser cells a box covers and what distance the box is at, e.g. for the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Laser-extent box refinement: a detection's left and right edges moved outwards to where the
 // object's cluster in the `distance` layer ends. The cascade scans one window aspect (car 36x24 =

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MultiDetector: every class on one stack in one pass - what a robot runs on each stack.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The one-window scalar scan of our models on per-layer integral tables (internal to boost/):
 // per scale, every stump's rectangle corners as offsets from the window's origin in its layer's

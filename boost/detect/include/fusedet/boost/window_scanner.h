@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The scanner of our models (internal to boost/; Detector and MultiDetector are the entry points).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Percentile bootstrap intervals over frames: the frames of a test set are resampled with
 // replacement (a fixed seed, so a report is reproducible) and a measure is recomputed on each

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The held-back evaluation loop: running cascades over data set items and scoring them (what
 // `fusedet eval`, `fusedet train --eval` and `fusedet experiments` share). A chain of several

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a label means for one class, in evaluation and in training: the KITTI rules of
 // evaluation.h made concrete per project class (the one place that decides them).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which frames train and which test: the one home of the split rules that `fusedet train`,
 // `fusedet eval`, `fusedet demo` and `fusedet experiments` use.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Evaluation of detections against labels (paper §4, design.md §5) with the KITTI object devkit's
 // 2D rules (cpp/evaluate_object.cpp), "moderate" difficulty by default:

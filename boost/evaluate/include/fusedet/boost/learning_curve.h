@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a learning-curve point was trained on: the training items of a fold counted for one class
 // - items, positives (KITTI moderate, evaluation.h labelRole), distinct groups (raw drives) and

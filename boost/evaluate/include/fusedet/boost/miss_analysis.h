@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Where a missed object is lost: for every positive (evaluation.h's roles) that no detection hits,
 // which step of detection lost it, in this order of precedence:

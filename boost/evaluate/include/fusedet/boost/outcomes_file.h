@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // outcomes.json: the per-frame outcomes of one `fusedet experiments` run - for every class,
 // protocol (leave-one-drive-out or k drive-disjoint folds) and configuration, each test frame's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Paired comparison of two detectors on the same frames: F and AP of each, and the 95 % bootstrap
 // interval of the difference a - b with the frames resampled once for both (bootstrap.h), so a

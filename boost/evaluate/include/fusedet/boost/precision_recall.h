@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Ranking measures over many frames: the precision-recall curve over the detections' scores and
 // average precision (AP), as the KITTI object devkit computes them.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Feature: one of the ten feature types of the paper (Fig. 1, a-j) on one sensor layer, with its
 // rectangle in unit-square window coordinates (paper eq. 1, Fig. 4). Its value on a window is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The joint feature pool (paper §2, §3.2): every feature type x position x size (including aspect
 // ratio) on a grid over the unit square x every selected layer. A feature of type t with a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The ten Haar-like feature types of the paper (Fig. 1): a-f standard (edge x2, line x2, four-square
 // checker, centre-surround), g-j corner-like (2x2 quadrants, one quadrant against the other three).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A stump compares its feature value rounded to float with a float threshold:
 // static_cast<float>(v) < threshold. Rounding to float is monotone, so that test is a comparison of

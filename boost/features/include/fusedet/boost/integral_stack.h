@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // IntegralStack: summed-area tables of the layers of one LayerStack that a model reads, built
 // once per stack (paper §2). Sums are kept in double: exact for 8- and 16-bit layers (every

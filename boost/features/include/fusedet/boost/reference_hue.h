@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Per-class reference hue for the hue-distance layer (paper §3.1, Fig. 5), from coarse additive
 // histograms of 36 bins of 10 degrees, smoothed over neighbouring bins (circularly). Only pixels

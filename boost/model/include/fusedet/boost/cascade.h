@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Cascade: the in-memory model every part of boost/ shares - trained by training (model_io.h
 // reads and writes it), imported from OpenCV Haar XML (opencv_cascade.h), run by detector.h.

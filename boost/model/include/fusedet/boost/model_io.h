@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Model files of our cascades: versioned, human-readable JSON (one stump per line), holding the
 // class, window size (aspect ratio), layer names, reference hue and the stages with their

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Import of OpenCV Haar cascades as Debian's opencv-data ships them
 // (/usr/share/opencv4/haarcascades): the current format (<cascade> with stageType BOOST,

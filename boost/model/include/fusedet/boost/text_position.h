@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // "line L, column C" of a byte offset in a text: where a parser's error points (model and
 // outcomes files).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Training a cascade for one class (paper §2-§4, design.md §5): the library entry point that
 // `fusedet train` and `fusedet experiments` call.

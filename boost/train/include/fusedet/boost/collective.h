@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The collective operations distributed training needs (ranks 0..size-1 of one job), as an
 // abstract interface so that boost/ stays free of MPI: the MPI implementation lives in tools/mpi/

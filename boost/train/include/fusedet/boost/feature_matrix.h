@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // FeatureMatrix: the feature values of one training stage, quantised once into 8-bit bins per
 // feature and stored feature-major (row f = feature f over all samples), so that every boosting

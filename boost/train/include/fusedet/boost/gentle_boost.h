@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Gentle AdaBoost for one cascade stage (paper §2, Friedman/Hastie/Tibshirani's Gentle variant):
 // each round fits the weighted least-squares stump f_m (stump.h), F += f_m,

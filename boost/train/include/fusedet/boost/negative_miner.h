@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Negative mining for cascade training, incremental across stages. Every stage's bootstrapping
 // asks for the label-free windows of the training stacks that the cascade so far still accepts

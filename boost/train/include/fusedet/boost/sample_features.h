@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Evaluating the feature pool on the training samples of a stage, fast and exactly as
 // featureValue() (feature.h) does. A feature's pixel layout inside a window depends only on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Sample selection of a sharded training job (cascade_trainer.h with a Collective): every rank
 // works only on the stacks it owns (TrainingStacks' Shard) and the results are combined exactly,

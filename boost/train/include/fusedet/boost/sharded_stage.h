@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One boosting stage of a sharded training job (LightGBM's data-parallel scheme, made exact):
 //   - each rank evaluates the pool on the stage's samples that lie on its own stacks and bins

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The weak learner: a regression stump (CART of depth 1) fitted by weighted least squares on
 // labels y = +1 (positives) / -1 (negatives). Found in two steps, as LightGBM does:

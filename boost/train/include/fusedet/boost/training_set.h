@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Training samples (paper §4): positives from the labelled boxes of one class (optionally also
 // from horizontally flipped copies of their stacks), negatives bootstrapped for every new stage

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Optimal assignment (Kuhn-Munkres / Hungarian method with potentials, O(n^3)) of rows to columns
 // of a cost matrix, where a row or column may also stay unassigned at a fixed price: the tracker's

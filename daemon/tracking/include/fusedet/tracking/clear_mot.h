@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CLEAR MOT (Bernardin & Stiefelhagen 2008) as TrackEval computes it: per frame a truth object
 // and a hypothesis match when their IoU >= minIou; the pairs matched in the previous frame are

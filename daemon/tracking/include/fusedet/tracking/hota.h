@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // HOTA (Luiten et al., IJCV 2021, "HOTA: A Higher Order Metric for Evaluating Multi-Object
 // Tracking") with IoU similarity, at the 19 localisation thresholds alpha = 0.05, 0.10, ..., 0.95,

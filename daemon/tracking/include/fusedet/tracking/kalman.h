@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ConstantVelocityKalman: one object's 3D position and velocity in the robot frame, a linear
 // Kalman filter with a constant-velocity motion model (state [x y z vx vy vz]) and

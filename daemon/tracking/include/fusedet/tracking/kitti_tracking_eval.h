@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Tracks measured on a KITTI tracking sequence, per class: CLEAR MOT and HOTA of the confirmed
 // tracks, and detection recall / precision / F of every detection against only the detections

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MotSequence: what the MOT metrics (clear_mot.h, hota.h) score - per frame, the ground-truth
 // objects and the tracker's hypotheses, each an id and an image box, after ignored labels and

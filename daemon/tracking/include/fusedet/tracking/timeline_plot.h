@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A picture of tracks over time (docs/tracking.md): per class a panel with one row per ground-truth
 // object and one column per frame; a cell is filled in the colour of the track id that matched

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Tracker: the multi-object track manager after detection. Per stack (with its stamp) it takes
 // the detections with a laser-measured 3D position in the robot frame, predicts every live track

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CanBus: what the CANopen master and the motor simulator need from a CAN network. Two
 // implementations: SocketCanBus (a Linux raw CAN socket) and InProcessBus::Endpoint (tests and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CanFrame: one classic CAN 2.0 frame (11- or 29-bit id, 0..8 data bytes, RTR, or a SocketCAN
 // error frame) with its reception (or send) stamp.

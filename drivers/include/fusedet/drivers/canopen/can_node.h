@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CanNode: something that lives on a CAN bus as an event-driven state machine (the tilt drive
 // master, the motor simulator). It never blocks: frames go in through onFrame(), time through

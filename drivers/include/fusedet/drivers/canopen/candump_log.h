@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The can-utils `candump -l` log format, one frame a line:
 //   (1700000000.123456) can0 123#DEADBEEF      11-bit id, data in hex

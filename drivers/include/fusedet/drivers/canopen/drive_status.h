@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // queryDriveStatus: a one-shot look at a CiA 402 drive over SDO (what `fusedet tilt status`
 // prints): device type and name, NMT state (from its heartbeat or boot-up, if heard), statusword

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // describeFrame: one line of CANopen meaning for a frame (what `fusedet tilt monitor` prints),
 // e.g. "SDO request node 5: upload 0x6041:00" or "EMCY node 5: EMCY 0x8611 following error (...)".

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // InProcessBus: a CAN network inside one process, for tests and `fusedet tilt simulate`. Each
 // connect() gives an Endpoint (a CanBus) that receives every frame the other endpoints send,

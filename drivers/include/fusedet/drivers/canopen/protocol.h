@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CANopen CiA 301 / CiA 402 facts (design.md §3): COB-IDs, NMT, SDO command bytes, abort codes,
 // EMCY, heartbeat states, statusword/controlword. Pure functions, no I/O.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SdoClient: the client side of one node's default SDO channel (request 0x600+n, response
 // 0x580+n). Asynchronous, so the master's single loop keeps producing SYNC and consuming PDOs

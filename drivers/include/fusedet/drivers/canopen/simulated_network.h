@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SimulatedNetwork: an InProcessBus on a simulated clock with the nodes attached to it. advance()
 // moves time in fixed steps; in each step every node is polled and all frames in flight are

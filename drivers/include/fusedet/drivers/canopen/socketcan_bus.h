@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SocketCanBus: a Linux raw CAN socket (PF_CAN, SOCK_RAW, CAN_RAW) bound to one interface
 // (can0, vcan0, ...). Non-blocking: every wait is a poll() with a timeout. Receive filters are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // TiltDrive: the CANopen master for the nodding tilt motor (one CiA 402 drive), as a CanNode.
 // Bring-up: NMT reset node, wait for the boot-up message, check the device type (402), read the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // TiltTpdoDecoder: the tilt motor's TPDO1 -> TiltSample. TiltDrive maps TPDO1 (COB-ID 0x180 +
 // node, sent on every SYNC) as position actual value (0x6064, int32 LE) + statusword (0x6041,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // TiltUnits: drive position counts <-> tilt angle, from the config's `tilt:` keys
 // (counts_per_rev, gear_ratio, zero_offset_counts): angle = 2 pi (counts - zero) / (cpr * gear).

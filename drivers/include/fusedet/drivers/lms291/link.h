@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Link: the request/reply side of the telegram layer over a serial port. Sends a request,
 // waits for the lone ACK (NAK => wait 30 ms and resend), then for the reply (request | 0x80),

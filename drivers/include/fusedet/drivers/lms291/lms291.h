@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Lms291: the device layer of the SICK LMS 291 driver. Finds the device's current speed by
 // probing, switches to the configured speed, sets units (mm), measuring mode, variant, starts

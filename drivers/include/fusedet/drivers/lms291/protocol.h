@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SICK LMS 2xx protocol contents: commands, modes, baud codes, the status byte, and the decoding
 // of measured-value (B0), range+remission (F5), status (B1) and configuration (F4) payloads.

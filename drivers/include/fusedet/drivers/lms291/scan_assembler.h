@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ScanAssembler: merges the interlaced partial scans of mode 2A into full scans. At 0.5 deg a
 // full scan is 2 mirror rotations (partial index 0, 2 in 0.25 deg steps), at 0.25 deg 4 (0..3).

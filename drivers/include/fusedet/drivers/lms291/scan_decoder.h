@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ScanDecoder: device telegrams -> LaserScan messages, for the device state the driver set up
 // (variant, range or range+remission output, measuring mode, unit). The live driver (Lms291) and

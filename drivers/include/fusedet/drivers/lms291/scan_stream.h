@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ScanStream: runs an Lms291 on its own thread and keeps it running. When the port vanishes
 // (USB adapter unplugged) or the device falls silent, it closes, waits (back-off doubling from

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SICK LMS 2xx telegram layer: framing, the LMS CRC, and a byte-stream reader that finds
 // telegrams and lone ACK/NAK bytes in a noisy serial stream and resynchronises after garbage.

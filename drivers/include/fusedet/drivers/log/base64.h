@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Base64 (RFC 4648, standard alphabet, padded): how JSON-encoded MCAP messages carry bytes
 // (the Foxglove convention for `bytes` fields).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CAN frames between sensor logs and drivers/canopen: conversions between the log's CanMessage
 // and canopen::CanFrame (what the buses and their recording hooks carry), and the export of a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What fusedet sensor logs carry: topics, their schemas (JSON Schema, messages JSON-encoded) and
 // the codecs between driver messages and those JSON messages. Documented in docs/log-format.md.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What `fusedet log info` reports about a sensor log: per channel the message count, time span,
 // rate and gaps; for the file its chunks, metadata and every kind of damage the reader found

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // McapReader: reads an MCAP file (mcap_records.h) by one linear pass over its data section, so it
 // needs neither the summary nor the footer: a file cut by a crash or power loss is read up to its

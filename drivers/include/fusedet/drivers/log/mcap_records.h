@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MCAP container records (https://mcap.dev/spec, format version 0), as plain data. Written by
 // McapWriter, read by McapReader. All integers little-endian; times are uint64 nanoseconds

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // McapWriter: writes one MCAP file (mcap_records.h) - chunked, zstd-compressed, each chunk with
 // its CRC and message indexes, and at close() the summary (schemas, channels, statistics, chunk

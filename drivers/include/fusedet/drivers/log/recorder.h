@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Recorder: one MCAP sensor log written from several driver threads (the drivers' recording
 // hooks call record()). Channels are created on first use with the topics and schemas of

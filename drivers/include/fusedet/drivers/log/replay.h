@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Replay of a sensor log (docs/log-format.md) through the decoders the live drivers use.
 //

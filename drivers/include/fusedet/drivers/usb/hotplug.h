@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // UsbHotplug: libusb hotplug callbacks on their own thread, so the daemon reopens a replugged
 // laser adapter or camera at once instead of waiting for its back-off. Where libusb has no

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // UsbSysfs: what the kernel's sysfs tells about a USB device without opening it: its string
 // attributes (serial, manufacturer, product) and the /dev nodes its interfaces' drivers made

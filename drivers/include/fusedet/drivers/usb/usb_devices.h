@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // USB devices through libusb: list those matching VID:PID[:SERIAL] with their /dev nodes (via
 // UsbSysfs), and reset one that stopped answering (USBDEVFS_RESET through libusb_reset_device;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // UsbMatch: which USB device is meant, written VID:PID[:SERIAL][@PORT] in hex (e.g. "0403:6001",
 // "0403:6001:A50285BI" or "046d:0825@1-2.3"), as in the configuration and `fusedet usb reset`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // BufferRing: which mmap buffers the kernel holds (queued) and which the application holds, as
 // pure bookkeeping. V4l2Camera checks every VIDIOC_DQBUF answer against it, so a driver that

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // V4l2Camera: the device layer of the V4L2 capture driver. start() opens the node, checks
 // VIDIOC_QUERYCAP (single-planar video capture + streaming), negotiates format and size

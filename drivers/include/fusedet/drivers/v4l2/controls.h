@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Exposure and gain: automatic or fixed from the configuration. planControls() turns the
 // configuration and what the device reported for its controls (VIDIOC_QUERYCTRL/QUERYMENU)

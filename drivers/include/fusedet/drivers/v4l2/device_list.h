@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Finding and describing V4L2 nodes for `fusedet camera list`: which /dev/videoN exist, what
 // each can do and, for capture devices, every format, size and frame interval offered.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // FrameStream: runs a V4l2Camera on its own thread and keeps it running. No frame for
 // `stallLimit`: the stream is restarted (STREAMOFF/STREAMON) up to `maxRestarts` times in a row,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Format negotiation for V4L2 capture, as pure logic: what the device offers (filled from
 // VIDIOC_ENUM_FMT / ENUM_FRAMESIZES / ENUM_FRAMEINTERVALS by V4l2Camera, or by a test) against

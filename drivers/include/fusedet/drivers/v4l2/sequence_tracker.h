@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // SequenceTracker: counts frames the driver dropped, from the 32-bit sequence numbers of
 // dequeued buffers. A jump forward of k means k-1 frames lost; a step back (or a repeat) means

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // StallPolicy: decides, from frame arrival times alone, when a stream has stalled and what to do:
 // restart the stream (STREAMOFF/STREAMON on the open device) up to `maxRestarts` times in a row,

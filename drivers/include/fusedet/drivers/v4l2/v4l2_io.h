@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // V4l2Io: the only door between V4l2Camera and the kernel: open, ioctl, mmap, poll. The camera's
 // logic (negotiation, buffer bookkeeping, timestamps, sequence gaps, restarts) runs unchanged

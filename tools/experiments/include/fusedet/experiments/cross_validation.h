@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Cross-drive validation (data_split.h folds): for each fold a cascade is trained on the training
 // groups' items (labels as trainingLabels() gives them for the class) and run on the held-out

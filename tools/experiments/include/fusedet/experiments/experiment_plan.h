@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What one `fusedet experiments` run does, as a named preset: the training of every fold's
 // cascade, the detection on the test frames, the fold design, the configurations and for which

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A sensor log as calibration input: the log is replayed through the live decoders with the rig
 // it carries (metadata "fusedet.config"), sweeps are assembled and paired with camera frames as

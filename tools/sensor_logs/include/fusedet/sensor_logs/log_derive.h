@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // deriveLog: a sensor log made viewable - the raw streams of IN copied to OUT, plus the channels
 // a person needs to see it in Foxglove (docs/log-format.md, "Derived channels"), computed by

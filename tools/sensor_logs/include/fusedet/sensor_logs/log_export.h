@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Exports of a sensor log for other tools: camera frames as PNG files, sweeps as PLY point
 // clouds. Frames are decoded as live (decodeCameraFrame); sweeps are the log's /sweep/points

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // KITTI frames as calibration input: one rig (the frames whose calib files agree), a few frames
 // spread over the drives given, the rig's pinhole and its laser->camera transform.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Pictures that let a person judge an extrinsic calibration: laser points drawn on the camera
 // image, coloured by distance (near red, far blue), so misalignment shows at object outlines.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Targetless laser->camera calibration: refines all 6 degrees of freedom of the extrinsics from a
 // few frames of ordinary scenes by maximising the agreement between what the laser and the camera

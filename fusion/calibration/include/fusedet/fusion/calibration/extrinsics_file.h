@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The laser->camera extrinsics as the config's `fusion.laser_to_camera` block: a YAML file that
 // is also a valid fusedetd config (every other key at its default), so `fusedet calibrate` output

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Nelder-Mead downhill simplex (Nelder & Mead 1965; Lagarias et al. 1998 coefficients): a
 // derivative-free minimiser for the calibration costs, which are piecewise constant at the scale of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Score profiles of targetless calibration: the agreement measures along each of the 6 axes
 // around a transform. The diagnosis before trusting an optimiser: at the right transform every

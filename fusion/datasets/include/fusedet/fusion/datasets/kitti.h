@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading one frame of a KITTI-layout directory (image_2/, velodyne/, calib/, label_2/), as the
 // object and tracking benchmarks lay it out. Format facts: Geiger et al., IJRR 2013.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The raw KITTI drive each frame of a KITTI-layout directory comes from, read from the
 // directory's SOURCE.md, so that cross-drive validation keeps frames of one drive (the same

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // KITTI import: each frame of a KITTI-layout directory goes through the same projection code as
 // live data (Fuser) and is written as one item of a data set (core/dataset.h). One directory =

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which physical object each label of a KITTI tracking drive is. The drives 0005 and 0009 of
 // ../shared/data carry their tracking label file (tracking_label_02_NNNN.txt: the object-layout

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Labels and detections drawn on an 8-bit BGR image: the one box-drawing rule of the project
 // (`fusedet show`'s mosaics, `fusedet detect --draw`). Labels: green (car/person/bike/...),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The detections file `fusedet show --detections` reads:
 //   {"detections": [{"class": "car", "score": 3.2, "x": 10, "y": 20, "w": 40, "h": 30}, ...]}

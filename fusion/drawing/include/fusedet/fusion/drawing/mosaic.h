@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A picture of what the detector sees (like paper Fig. 8): every layer of a stack as one tile,
 // scaled to the reference size, with labels and detections drawn on each tile.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // BGR image -> CameraFrame in a camera's raw format: what a V4L2 camera would have delivered for
 // that picture (synthetic logs). YUYV uses ITU-R BT.601 limited range, the inverse of what

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // PointRayCaster: casts rays into a measured point cloud (a Velodyne sweep) - what a laser beam
 // through that scene would have returned. Points are binned by direction as seen from the cloud's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // synth-log: a realistic raw sensor log (docs/log-format.md) made from real KITTI frames, or
 // from a procedural scene when no KITTI data is given.

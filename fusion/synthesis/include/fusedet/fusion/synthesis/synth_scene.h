@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scenes a synthetic laser scans (synth-log): rays in the laser base frame (x ahead, y left,
 // z up) -> the first surface hit. CloudScene resamples a measured cloud (a KITTI Velodyne sweep);
