@@ -7,7 +7,7 @@
 // own scan and neighbours: class_detection.h); alone, car F at IoU 0.7 rises from 0.43
 // to 0.49 on 3 drive-disjoint folds but only from 0.51 to 0.53 leave-one-drive-out (+4 hits of
 // 186; paired interval of the difference +0.02 [-0.005, 0.05]: a tie across drives; `fusedet
-// compare`, boost/README.md).
+// compare`, docs/results/README.md "Options").
 //
 // Rule, in the distance layer's cells (the box read through laser_cells.h, which owns the band,
 // the core and the box's distance):
