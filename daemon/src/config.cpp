@@ -17,6 +17,20 @@
 namespace fusedet::daemon {
 namespace {
 
+// Keys a former release read, with what to do instead: a config written for it fails with this
+// hint rather than a bare "unknown key". Matched on the key's last part within its section.
+struct RemovedKey {
+  const char* section;
+  const char* key;
+  const char* why;
+};
+constexpr RemovedKey kRemovedKeys[] = {
+    {"detection", "grouping",
+     "was removed (commit c0a1fa7): NMS grouping lost to OpenCV's rule on every drive, which fusedetd now always "
+     "uses (detection.min_neighbors); delete the key (docs/results/README.md, Options)"},
+    {"detection", "nms_iou", "was removed with NMS grouping (commit c0a1fa7); delete the key (docs/results/README.md, Options)"},
+};
+
 // Walks one YAML mapping, reads known keys into fields and rejects unknown ones, so a typo in a
 // key never silently falls back to a default.
 class Section {
@@ -93,7 +107,10 @@ class Section {
     if (!node_ || !node_.IsMap()) return;
     for (const auto& kv : node_) {
       const std::string key = keyName(kv.first, path_);
-      if (!seen_.count(key)) fail(kv.first, "unknown key " + keyPath(key.c_str()));
+      if (seen_.count(key)) continue;
+      for (const RemovedKey& r : kRemovedKeys)
+        if (key == r.key && path_.rfind(r.section, 0) == 0) fail(kv.first, "key " + keyPath(key.c_str()) + " " + r.why);
+      fail(kv.first, "unknown key " + keyPath(key.c_str()));
     }
   }
 

@@ -37,6 +37,17 @@ TEST(Config, EmptyFileGivesDefaultsAndDumpRoundTrips) {
   EXPECT_EQ(back.detection.models, changed.detection.models);
 }
 
+// A config written for a release that had NMS grouping names the removed keys and what to do.
+TEST(Config, RemovedKeysSayTheyWereRemovedAndWhatToDo) {
+  const std::string grouping = errorOf("detection:\n  min_neighbors: 3\n  grouping: nms\n");
+  EXPECT_EQ(grouping.rfind("test.yaml:3: key detection.grouping was removed (commit c0a1fa7)", 0), 0u) << grouping;
+  EXPECT_NE(grouping.find("delete the key"), std::string::npos) << grouping;
+  const std::string perClass = errorOf("detection:\n  classes:\n    car:\n      nms_iou: 0.4\n");
+  EXPECT_EQ(perClass.rfind("test.yaml:4: key detection.classes.car.nms_iou was removed", 0), 0u) << perClass;
+  // Only in the section that had it: elsewhere the same name is just unknown.
+  EXPECT_EQ(errorOf("tracking:\n  grouping: 1\n"), "test.yaml:2: unknown key tracking.grouping");
+}
+
 TEST(Config, ErrorsNameFileLineAndKey) {
   EXPECT_EQ(errorOf("laser:\n  baud: 12345\n"),
             "test.yaml:2: key laser.baud: '12345' is not one of: 9600 19200 38400 500000");
