@@ -6,7 +6,7 @@
 // which detections are ignored is boost/class_rules.h (matchConfigFor: KITTI moderate, Van the
 // ignored neighbour of car, DontCare absorbs), at IoU 0.5 for every class as the KITTI tracking
 // benchmark scores; a detection the rules ignore is no hypothesis for the MOT metrics either.
-// Library `fusedet_tracking_eval` (it needs boost/ and fusion/; the tracker does not).
+// Library `fusedet_tracking_eval` (it needs boost/'s evaluation; the tracker does not).
 
 #include <cstdint>
 #include <optional>
