@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // fusedet compare: two `fusedet experiments` runs (an option against the default) judged on the
 // same frames with paired bootstrap intervals of F and AP. The rules are in
-// boost/paired_comparison.h and boost/outcomes_file.h; this parses and prints.
+// fusedet/boost/paired_comparison.h and fusedet/boost/outcomes_file.h; this parses and prints.
 
 #include <algorithm>
 #include <cstdio>

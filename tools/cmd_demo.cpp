@@ -176,8 +176,8 @@ const bool registered = registerCommand(
       app.add_option("--threads", o->threads, "detection threads; 0 = all cores")->capture_default_str();
       app.add_flag("!--no-class-detection", o->classDetection,
                    "group every class with the general settings (3 neighbours, no laser extent), car included; by "
-                   "default each class with settings of its own (boost/class_detection.h: car 16 neighbours and "
-                   "laser extent) gets them, as in fusedetd's built-in detection.classes");
+                   "default each class with settings of its own (fusedet/boost/class_detection.h: car 16 "
+                   "neighbours and laser extent) gets them, as in fusedetd's built-in detection.classes");
       app.footer(
           "Reads image_2, velodyne, calib and label_2 of one frame, fuses it (camera layers red, green,\n"
           "blue, intensity, hue at image size; distance and remission at half size with a validity\n"
@@ -185,7 +185,7 @@ const bool registered = registerCommand(
           "Then runs every model in --models (the bundled models/<class>.json by default) on the stack\n"
           "as fusedetd does with its built-in settings: one pass at scale factor 1.1, step 2, then each\n"
           "class grouped by OpenCV's rule - car with its own settings (16 neighbours, boxes widened to the\n"
-          "laser's object; boost/class_detection.h, docs/results, \"Options\"), person and bike with\n"
+          "laser's object; fusedet/boost/class_detection.h, docs/results, \"Options\"), person and bike with\n"
           "3 neighbours and no laser extent (--no-class-detection: every class so). Prints the time of that\n"
           "pass, each class's settings and each detection with the label it matches (IoU >= 0.5), if\n"
           "any. The bundled models are trained on every shared frame, the demo frames included: the\n"

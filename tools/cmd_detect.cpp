@@ -208,12 +208,12 @@ const bool registered = registerCommand(
                      "class, car included");
       app.add_flag("--laser-extent", o->laserExtent,
                    "after grouping, widen each detection's left and right edges to where its object's cluster in the "
-                   "distance layer ends (boost/laser_extent.h) - needs a --stack with a distance layer. Default: the "
-                   "class's own (car on), else off; given, on for every class");
+                   "distance layer ends (fusedet/boost/laser_extent.h) - needs a --stack with a distance layer. "
+                   "Default: the class's own (car on), else off; given, on for every class");
       app.add_flag("!--no-class-detection", o->classDetection,
                    "group with the general settings (--min-neighbors or 3, --laser-extent or off) whatever the "
-                   "model's class; by default a class with settings of its own (boost/class_detection.h: car, 16 "
-                   "neighbours and laser extent) gets them for every option not given, as in fusedetd");
+                   "model's class; by default a class with settings of its own (fusedet/boost/class_detection.h: "
+                   "car, 16 neighbours and laser extent) gets them for every option not given, as in fusedetd");
       app.add_option("--min-size", o->minSize,
                      "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
                      "smallest training positive, in models that have one - else its base window)");
@@ -235,8 +235,8 @@ const bool registered = registerCommand(
           "  fusedet detect -m models/car.json --stack data/kitti_set --no-class-detection   # car as person/bike\n"
           "Prints a summary line, the grouping used, then one line per detection (class, score, box in pixels).\n\n"
           "Settings per class: the model's class is grouped as fusedetd groups it (its built-in\n"
-          "detection.classes, boost/class_detection.h): car with 16 neighbours and its boxes widened to the\n"
-          "laser's object (docs/results, \"Options\"), every other class with 3 neighbours and no\n"
+          "detection.classes, fusedet/boost/class_detection.h): car with 16 neighbours and its boxes widened\n"
+          "to the laser's object (docs/results, \"Options\"), every other class with 3 neighbours and no\n"
           "laser extent. --min-neighbors and --laser-extent, when given, hold for every class instead of its\n"
           "own value; --no-class-detection gives every class the general settings. The scan (scale factor\n"
           "1.1, step 2) is the same for every class. Car's own settings need the laser: on an --image its\n"

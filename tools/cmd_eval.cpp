@@ -195,7 +195,8 @@ const bool registered = registerCommand(
       app.add_option("--step", o->step, "position step in base-window pixels")->capture_default_str();
       app.add_option("--min-neighbors", o->minNeighbors, "grouping: hits a detection needs")->capture_default_str();
       app.add_flag("--laser-extent", o->laserExtent,
-                   "after grouping, widen each detection's left and right edges to where its object's cluster in the " "distance layer ends (boost/laser_extent.h; default: off)");
+                   "after grouping, widen each detection's left and right edges to where its object's cluster in "
+                   "the distance layer ends (fusedet/boost/laser_extent.h; default: off)");
       app.add_option("--threads", o->threads, "detection threads (ms per stack is measured with these)")
           ->capture_default_str();
       app.footer(

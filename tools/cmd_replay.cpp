@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // fusedet replay: a sensor log through fusedetd's pipeline as fast as the machine allows, writing
 // the `detections` lines a subscribed socket client would get (docs/protocol.md), one per stack.
-// The work is daemon/offline_replay.h; this file parses and prints.
+// The work is fusedet/daemon/offline_replay.h; this file parses and prints.
 
 #include <chrono>
 #include <cstdio>
@@ -55,8 +55,8 @@ const bool registered = registerCommand(
       app.add_option("-o,--out", o->out, "NDJSON file for the detections lines")->required();
       app.footer(
           "Runs the log through the same code as fusedetd with replay.file set (the log's rig, this\n"
-          "config's detection, models and tracking; daemon/offline_replay.h), as fast as possible and\n"
-          "losslessly (every stack detected), with the log's recorded stamps, and writes one\n"
+          "config's detection, models and tracking; fusedet/daemon/offline_replay.h), as fast as\n"
+          "possible and losslessly (every stack detected), with the log's recorded stamps, and writes one\n"
           "\"detections\" line per stack, as a subscribed client gets it (docs/protocol.md; timing\n"
           "fields are this run's). Prints a summary on stderr.\n\n"
           "Examples:\n"

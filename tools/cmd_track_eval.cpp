@@ -138,7 +138,7 @@ const bool registered = registerCommand(
       app.add_flag("--json", o->json, "print JSON instead of the markdown table");
       app.footer(
           "Each stack is the KITTI frame whose synthesised stroke holds its sweep's middle. Per class:\n"
-          "labels and ignored detections by boost/class_rules.h (KITTI moderate, Van ignored for car,\n"
+          "labels and ignored detections by fusedet/boost/class_rules.h (KITTI moderate, Van ignored for car,\n"
           "DontCare absorbs) at IoU 0.5; hypotheses = detections of confirmed tracks, ids = track ids;\n"
           "CLEAR MOT (MOTA, MOTP, id switches, fragmentations, mostly tracked/partially/lost), HOTA\n"
           "(DetA, AssA, LocA), and recall/precision/F of every detection (raw) against confirmed ones.\n\n"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// fusedet train: trains one class's cascade on a data set (boost/cascade_trainer.h) and writes the
-// model file (boost/model_io.h). Progress: a live status line on a terminal, plain log lines
+// fusedet train: trains one class's cascade on a data set (fusedet/boost/cascade_trainer.h) and writes the
+// model file (fusedet/boost/model_io.h). Progress: a live status line on a terminal, plain log lines
 // otherwise. Started by mpirun/srun, the ranks share the work (docs/distributed.md): each loads
 // the pixels of its own items only, rank 0 prints and writes the model.
 
@@ -149,8 +149,9 @@ class ConsoleProgress final : public boosting::ProgressSink {
 };
 
 // Recall / precision / F-measure of the new cascade on the held-back items, with `fusedet eval`'s
-// defaults: the KITTI devkit's 2D rules of boost/evaluation.h (moderate, IoU >= 0.7 for car and 0.5 for person and bike, DontCare,
-// neighbouring classes ignored) through boost/chain_evaluation.h; OpenCV-style grouping.
+// defaults: the KITTI devkit's 2D rules of fusedet/boost/evaluation.h (moderate, IoU >= 0.7 for car
+// and 0.5 for person and bike, DontCare, neighbouring classes ignored) through
+// fusedet/boost/chain_evaluation.h; OpenCV-style grouping.
 void evaluateHeldBack(const TrainOptions& o, const boosting::Cascade& cascade,
                       const std::vector<std::string>& testIds) {
   if (testIds.empty()) {
@@ -216,7 +217,7 @@ int runTrain(const TrainOptions& o, MpiJob* job) {
   c.validate();
   if (!(o.split > 0 && o.split <= 1)) throw std::runtime_error("--split must be in (0, 1]");
 
-  // Train/test split per group, in manifest (frame) order (boost/data_split.h).
+  // Train/test split per group, in manifest (frame) order (fusedet/boost/data_split.h).
   const auto all = readDatasetManifest(o.data);
   const std::set<std::string> groups(o.groups.begin(), o.groups.end()),
       trainOnly(o.trainOnly.begin(), o.trainOnly.end());
@@ -311,7 +312,8 @@ const bool registered = registerCommand(
       auto o = std::make_shared<TrainOptions>();
       app.add_option("--data", o->data, "data set directory (docs/dataset-format.md), e.g. from import-kitti")
           ->required();
-      app.add_option("-o,--out", o->out, "model file to write (JSON, boost/model_io.h); default: <class>.json");
+      app.add_option("-o,--out", o->out,
+                     "model file to write (JSON, fusedet/boost/model_io.h); default: <class>.json");
       app.add_option("--class", o->className,
                      "class to train: labels of this class are positives, every other label and the "
                      "background are negatives (car: vans are ignored, as by KITTI's devkit), ignore regions are "

@@ -18,7 +18,7 @@ struct Measured {
 
 Measured measure(const std::vector<boosting::FrameOutcome>& frames, const boosting::BootstrapConfig& b);
 
-// Paired difference a - b of F and AP on the same resampled frames (boost/paired_comparison.h).
+// Paired difference a - b of F and AP on the same resampled frames (fusedet/boost/paired_comparison.h).
 Claim compare(const std::string& cls, const std::string& key, const std::string& text, const std::string& lhs,
               const std::vector<boosting::FrameOutcome>& a, const std::string& rhs,
               const std::vector<boosting::FrameOutcome>& b, const boosting::BootstrapConfig& boot);

@@ -20,11 +20,11 @@ std::vector<fs::path> kittiDrives(const fs::path& root);
 fs::path resolveDataset(const ExperimentOptions& o);
 
 // The raw drive of every manifest entry: from the SOURCE.md of the KITTI directory the entry's
-// group was imported from (fusion/datasets/kitti_drives.h), else the group itself.
+// group was imported from (fusedet/fusion/datasets/kitti_drives.h), else the group itself.
 std::vector<std::string> drivesOf(const ExperimentOptions& o, const std::vector<DatasetEntry>& manifest);
 
-// The physical object of every label (boost/learning_curve.h): "<drive>/track <id>" where the
-// KITTI folder has its tracking label file (fusion/datasets/kitti_tracks.h), else "" (counted once).
+// The physical object of every label (fusedet/boost/learning_curve.h): "<drive>/track <id>" where the
+// KITTI folder has its tracking label file (fusedet/fusion/datasets/kitti_tracks.h), else "" (counted once).
 std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, const std::vector<DatasetEntry>& manifest,
                                                   const std::vector<Labels>& labels,
                                                   const std::vector<std::string>& driveOf);

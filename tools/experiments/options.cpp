@@ -10,7 +10,8 @@
 
 namespace fusedet::tools::experiments {
 namespace {
-// " (bundled: 8, quick: 6)": every preset's value of a field (tools/experiments/experiment_plan.h), for --help.
+// " (bundled: 8, quick: 6)": every preset's value of a field (fusedet/experiments/experiment_plan.h),
+// for --help.
 std::string presets(const std::function<std::string(const boosting::ExperimentPlan&)>& field) {
   std::string s;
   for (const std::string& n : boosting::experimentPlanNames())
@@ -284,13 +285,14 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
       ->capture_default_str();
   app.add_flag("--laser-extent", o->laserExtent,
                "after grouping, widen each test-frame detection's left and right edges to where its object's "
-               "cluster in the distance layer ends (boost/laser_extent.h; default: off, but car's own setting "
-               "where the preset uses per-class detection); given, it applies to every class");
+               "cluster in the distance layer ends (fusedet/boost/laser_extent.h; default: off, but car's own "
+               "setting where the preset uses per-class detection); given, it applies to every class");
   app.add_flag("!--no-class-detection", o->classDetection,
                "detect every class with the general settings (--scale-factor, --step, --min-neighbors, "
                "--laser-extent or the preset's), also car: by default the bundled preset detects car with its "
-               "own settings (boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, laser extent; "
-               "docs/results \"Car at IoU 0.7\"), and any of those four options given applies to every class");
+               "own settings (fusedet/boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, "
+               "laser extent; docs/results \"Car at IoU 0.7\"), and any of those four options given applies to "
+               "every class");
   app.add_option("--class-stages", o->classStagesText,
          "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
          "stages in every configuration and the learning curve (the same cascades as training with a stage "

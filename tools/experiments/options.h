@@ -50,7 +50,7 @@ struct ExperimentOptions {
   double step = 0;
   int minNeighbors = 3;
   bool laserExtent = false;  // boosting::LaserExtentParams on the test frames' detections
-  // Per-class detection settings (boost/class_detection.h, car) where the preset uses them; an
+  // Per-class detection settings (fusedet/boost/class_detection.h, car) where the preset uses them; an
   // option given on the command line applies to every class instead.
   bool classDetection = true;
   bool minNeighborsGiven = false, laserExtentGiven = false;
@@ -77,7 +77,7 @@ const TrainedConfig& trainedConfig(const std::string& name);
 // "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).
 std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option);
 
-// The preset (tools/experiments/experiment_plan.h) with the options given on the command line.
+// The preset (fusedet/experiments/experiment_plan.h) with the options given on the command line.
 boosting::ExperimentPlan planFor(const ExperimentOptions& o);
 
 // Grouping of the raw hits, as the options give it (fusedetd's detection.* keys mean the same).

@@ -132,8 +132,8 @@ std::string renderMarkdown(const ExperimentReport& r) {
            "frames with a positive", "drives with a positive"},
           body);
   }
-  md << "Evaluation: the KITTI object devkit's 2D rules (boost/evaluation.h). A detection hits a label "
-        "at the devkit's minimum overlap, IoU >= 0.7 for car and >= 0.5 for person and bike (unless the "
+  md << "Evaluation: the KITTI object devkit's 2D rules (fusedet/boost/evaluation.h). A detection hits a "
+        "label at the devkit's minimum overlap, IoU >= 0.7 for car and >= 0.5 for person and bike (unless the "
         "settings' \"hit overlap\" row names an override); DontCare absorbs a detection that lies inside "
         "it by that share of its area. Positives are KITTI \"moderate\": box height >= 25 px, occlusion <= 1, "
         "truncation <= 0.3 (the tracking-label drives 0005 and 0009 store truncation levels 0/1/2: "
@@ -378,8 +378,8 @@ std::string renderMarkdown(const ExperimentReport& r) {
     md << heading << "Cascades of configuration `" << config
        << "`, all folds together. The weight of a stump is |right - left|: the amount it moves the stage sum "
           "between its two sides. Shares are weights summed per layer, divided by the total; the second "
-          "table sums them per source (fusion/layer_sources.h: camera = red, green, blue, intensity, hue "
-          "distance; laser = distance, remission).\n\n";
+          "table sums them per source (fusedet/fusion/layer_sources.h: camera = red, green, blue, intensity, "
+          "hue distance; laser = distance, remission).\n\n";
     const std::vector<std::string> layers = orderedLayers(allLayers);
     std::vector<std::string> header{"class"};
     header.insert(header.end(), layers.begin(), layers.end());

@@ -3,7 +3,7 @@
 // `fusedet experiments`, output side: report.md (cross-drive tables with 95 % bootstrap intervals,
 // the paper's claims judged with paired intervals, learning curves, goals), results.json, and the
 // charts: precision-recall curves and learning curve per class, weight share by layer (Fig. 7).
-// The numbers come from the library (tools/experiments/cross_validation.h, bootstrap.h); this only prints.
+// The numbers come from the library (fusedet/experiments/cross_validation.h, bootstrap.h); this only prints.
 
 #include <filesystem>
 #include <map>
@@ -100,7 +100,7 @@ struct MissResult {
 struct ClassCounts {
   std::string className;
   std::size_t positives = 0, ignoredLabels = 0, frames = 0, drivesWithPositives = 0;
-  std::size_t objects = 0;  // distinct physical objects among the positives (boost/learning_curve.h)
+  std::size_t objects = 0;  // distinct physical objects among the positives (fusedet/boost/learning_curve.h)
 };
 
 // A goal of the issue ("car F >= 0.8"): the measured F, its interval and whether it is met.

@@ -4,7 +4,8 @@
 // trained per fold on the other drives and tested on the held-out drive, pooled over folds: F, AP
 // and bootstrap intervals, the paper's claims judged with paired intervals, learning curves,
 // OpenCV's HOG people detector as a peer; report.md, results.json and charts in the output
-// directory. The rules live in boost/ (data_split, cross_validation, bootstrap, evaluation).
+// directory. The rules live in boost/ (data_split, bootstrap, evaluation) and in
+// fusedet/experiments/cross_validation.h.
 
 #include "run.h"
 
@@ -178,7 +179,7 @@ int runExperiments(ExperimentOptions o) {
       {"detection scale factor / step", shortNum(preset.scaleFactor) + " / " + shortNum(preset.step)},
       {"training scan scale factor / step", shortNum(preset.trainScaleFactor) + " / " + shortNum(preset.trainStep)},
       {"grouping", groupingText(o)},
-      {"per-class detection (boost/class_detection.h; --no-class-detection: none)", perClassText},
+      {"per-class detection (fusedet/boost/class_detection.h; --no-class-detection: none)", perClassText},
       {"laser-extent box refinement (--laser-extent)",
        o.laserExtent ? "on: left/right edges widened to the distance layer's object cluster" : "off"},
       {"van for car", boosting::toString(van)},
@@ -236,7 +237,7 @@ int runExperiments(ExperimentOptions o) {
   for (std::size_t k : preset.learningDrives) learning.push_back(k == 0 ? mostDrives : std::min(k, mostDrives));
   report.learningFolds = foldsText(learningFolds.size(), driveCount);
 
-  // Training labels per class (boost/class_rules.h trainingLabels()): the evaluation positives,
+  // Training labels per class (fusedet/boost/class_rules.h trainingLabels()): the evaluation positives,
   // every other label of the class an ignored label; the test frames keep their labels.
   std::map<std::string, std::vector<DatasetItem>> trainItemsOf;  // layers are shared, only labels differ
   for (const std::string& cls : o.classes) {
