@@ -215,8 +215,7 @@ const bool registered = registerCommand(
                    "model's class; by default a class with settings of its own (fusedet/boost/class_detection.h: "
                    "car, 16 neighbours and laser extent) gets them for every option not given, as in fusedetd");
       app.add_option("--min-size", o->minSize,
-                     "smallest window WxH in image pixels (default: the model's own minimum - its \"min_height\", the "
-                     "smallest training positive, in models that have one - else its base window)");
+                     "smallest window WxH in image pixels (default: the model's base window)");
       app.add_option("--max-size", o->maxSize, "largest window WxH in image pixels (default: the whole image)");
       app.add_option("--step", o->step,
                      "our models: position step in base-window pixels, scaled with the window (OpenCV models use "
