@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// libfusedet_mpi.so: the Collective of boost/collective.h over MPI (MPI_COMM_WORLD), loaded by
+// libfusedet_mpi.so: the Collective of fusedet/boost/collective.h over MPI (MPI_COMM_WORLD), loaded by
 // openMpiJob() (mpi_job.h) only under an MPI launcher. Failure policy: an MPI error or a
 // collective that waits longer than the timeout ends the whole job with a message naming the
 // rank - a rank that died must never leave the others hanging.

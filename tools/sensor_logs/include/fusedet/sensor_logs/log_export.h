@@ -3,7 +3,7 @@
 // Exports of a sensor log for other tools: camera frames as PNG files, sweeps as PLY point
 // clouds. Frames are decoded as live (decodeCameraFrame); sweeps are the log's /sweep/points
 // messages if it has them, else assembled from the replayed raw laser and tilt streams with the
-// given rig (the log's own, see daemon/rig.h).
+// given rig (the log's own, see fusedet/daemon/rig.h).
 
 #include <cstdint>
 #include <filesystem>
