@@ -16,10 +16,8 @@
 #include <cstring>
 #include <deque>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
-#include <sstream>
 #include <system_error>
 
 #include "fusedet/daemon/protocol.h"
@@ -85,23 +83,28 @@ void checkSocketDirectory(const std::string& path) {
                                 "only fusedetd's user can write to (e.g. /run/fusedet)");
 }
 
-// The peer's groups: its primary gid and its supplementary groups (from /proc; none if it is gone).
-std::vector<unsigned> peerGroups(const ucred& peer) {
-  std::vector<unsigned> out{peer.gid};
-  std::ifstream status("/proc/" + std::to_string(peer.pid) + "/status");
-  std::string line;
-  while (std::getline(status, line))
-    if (line.rfind("Groups:", 0) == 0) {
-      std::istringstream in(line.substr(7));
-      unsigned g = 0;
-      while (in >> g) out.push_back(g);
+// The groups the peer had when it connected: its primary gid and its supplementary groups, from
+// the kernel (SO_PEERGROUPS, Linux >= 4.13). Not from /proc/<pid>/status: the packaged unit's
+// ProtectProc=invisible hides other users' processes from fusedetd, and by the time a queued
+// connection is accepted its pid may be gone or reused.
+std::vector<gid_t> peerGroups(int fd, const ucred& peer) {
+  std::vector<gid_t> out(32);
+  socklen_t len = static_cast<socklen_t>(out.size() * sizeof(gid_t));
+  while (::getsockopt(fd, SOL_SOCKET, SO_PEERGROUPS, out.data(), &len) < 0) {
+    if (errno != ERANGE || len <= out.size() * sizeof(gid_t)) {
+      spdlog::warn("server: SO_PEERGROUPS: {}; judging uid {} by its primary group only", std::strerror(errno), peer.uid);
+      return {peer.gid};
     }
+    out.resize(len / sizeof(gid_t));  // the kernel said how many
+  }
+  out.resize(len / sizeof(gid_t));
+  out.push_back(peer.gid);
   return out;
 }
 
-bool allowed(const ucred& peer, const ServerLimits& limits) {
+bool allowed(int fd, const ucred& peer, const ServerLimits& limits) {
   if (limits.allowGroups.empty() || peer.uid == 0 || peer.uid == ::geteuid()) return true;
-  for (const unsigned g : peerGroups(peer))
+  for (const gid_t g : peerGroups(fd, peer))
     for (const auto& [name, gid] : limits.allowGroups)
       if (g == gid) return true;
   return false;
@@ -297,7 +300,7 @@ void Server::accept() {
       spdlog::warn("server: SO_PEERCRED: {}; connection closed", std::strerror(errno));
       continue;
     }
-    if (!allowed(peer, limits)) {
+    if (!allowed(fd.get(), peer, limits)) {
       std::string groups;
       for (const auto& [name, gid] : limits.allowGroups) groups += (groups.empty() ? "" : ", ") + name;
       const std::string why = "not allowed: uid " + std::to_string(peer.uid) + " (pid " + std::to_string(peer.pid) +

@@ -376,6 +376,83 @@ TEST(ServerAccess, PeersAreKnownAndAllowGroupsRefusesOthers) {
   server.stop(std::chrono::steady_clock::now() + 1s);
 }
 
+// allow_groups judges the groups a client had when it connected (SO_PEERGROUPS), not what /proc
+// shows at accept time: the packaged unit hides other users' processes (ProtectProc=invisible),
+// and a queued client may be gone. Here the member connects, hands its socket to the parent and
+// exits before the server accepts: its /proc entry no longer exists, yet it is served.
+TEST(ServerAccess, AllowGroupsUsesTheGroupsAtConnectNotProc) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root: the client is a child dropped to uid 65534";
+  const std::string path = tempSocket("peergroups.sock");
+  constexpr gid_t kAllowed = 31337;
+  ServerLimits limits;
+  limits.allowGroups = {{"robots", kAllowed}};
+  SocketAccess everyone;
+  everyone.mode = 0666;
+  Server server(bindUnixSocket(path, everyone), limits, {});  // not started: connections queue
+  int pair[2];
+  ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, pair), 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const gid_t groups[] = {kAllowed};
+    if (::setgroups(1, groups) != 0 || ::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) ::_exit(3);
+    char byte = 'f';
+    iovec io{&byte, 1};
+    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+    msghdr msg{};
+    msg.msg_iov = &io;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    cmsghdr* cm = CMSG_FIRSTHDR(&msg);
+    cm->cmsg_level = SOL_SOCKET;
+    cm->cmsg_type = SCM_RIGHTS;
+    cm->cmsg_len = CMSG_LEN(sizeof(int));
+    std::memcpy(CMSG_DATA(cm), &fd, sizeof fd);
+    ::_exit(::sendmsg(pair[1], &msg, 0) == 1 ? 0 : 4);
+  }
+  ::close(pair[1]);
+  char byte = 0;
+  iovec io{&byte, 1};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+  msghdr msg{};
+  msg.msg_iov = &io;
+  msg.msg_iovlen = 1;
+  msg.msg_control = control;
+  msg.msg_controllen = sizeof control;
+  ASSERT_EQ(::recvmsg(pair[0], &msg, 0), 1);
+  ::close(pair[0]);
+  int client = -1;
+  ASSERT_NE(CMSG_FIRSTHDR(&msg), nullptr);
+  std::memcpy(&client, CMSG_DATA(CMSG_FIRSTHDR(&msg)), sizeof client);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child status " << status;
+  ASSERT_FALSE(std::filesystem::exists("/proc/" + std::to_string(pid))) << "the client's process still exists";
+
+  server.start();
+  constexpr char kHello[] = "{\"cmd\":\"hello\"}\n";
+  ASSERT_EQ(::send(client, kHello, sizeof kHello - 1, MSG_NOSIGNAL), static_cast<ssize_t>(sizeof kHello - 1));
+  std::string line;
+  pollfd p{client, POLLIN, 0};
+  char buf[4096];
+  while (line.find('\n') == std::string::npos && ::poll(&p, 1, 5000) == 1) {
+    const ssize_t n = ::read(client, buf, sizeof buf);
+    if (n <= 0) break;
+    line.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(client);
+  const auto hello = nlohmann::json::parse(line.substr(0, line.find('\n')), nullptr, false);
+  ASSERT_TRUE(hello.is_object()) << line;
+  EXPECT_EQ(hello["type"], "hello") << line;
+  EXPECT_EQ(server.counters().refusedNotAllowed, 0u);
+  server.stop(std::chrono::steady_clock::now() + 1s);
+}
+
 // The socket file gets socket.mode and socket.group; a path in a world-writable directory that
 // someone else owns is refused, saying why; a socket passed by systemd that grants more than
 // socket.mode is refused.
