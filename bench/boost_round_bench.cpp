@@ -2,7 +2,7 @@
 // One boosting round (the best regression stump over the whole pool) on the same precomputed
 // feature matrix, three ways in one run with the same thread count:
 //   ours:      8-bit bins per feature (built once per stage), weighted histograms + split scan,
-//              exact refinement of the best candidates (boost/stump.h);
+//              exact refinement of the best candidates (fusedet/boost/stump.h);
 //   XGBoost:   C API, tree_method=hist, max_depth=1, reg:squarederror on y = +-1 with the same
 //              sample weights, lambda = 0, eta = 1 (its leaf is then the weighted mean of y, the
 //              same least-squares stump);

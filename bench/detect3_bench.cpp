@@ -3,7 +3,7 @@
 // stack - the frame `fusedet demo` detects on - in one pass (scale factor 1.1, step 2) grouped two
 // ways: every class with the general settings (detect(): OpenCV grouping, 3 neighbours, no laser
 // extent) and as fusedetd, demo and detect do (detectPerClass() with classGroupings(): car with 16
-// neighbours and its boxes widened to the laser's object, boost/class_detection.h); and two
+// neighbours and its boxes widened to the laser's object, fusedet/boost/class_detection.h); and two
 // yardsticks measured in the same process, interleaved round by round so that the load of a shared
 // machine hits all alike:
 //   - the previous per-class path: each model on its own integrals, scanned one window at a time
@@ -209,9 +209,10 @@ int main(int argc, char** argv) try {
               "the stack's intensity layer with the same scale factor 1.1 and minNeighbors 3 and its own window step\n"
               "(2 pixels below scale 2, then 1): a different cascade, so a yardstick of the machine, not the same work;\n"
               "fusedetd's path does the same scan as the first row and groups car with 16 neighbours and then\n"
-              "widens car's boxes to the laser's object (boost/laser_extent.h): OpenCV's peer has no laser layer and\n"
-              "no laser extent step, so that part of fusedetd's path is work the peer does not do; fusedetd runs it on\n"
-              "all cores (detection.threads 0), here on one thread like every other 1-thread row\n");
+              "widens car's boxes to the laser's object (fusedet/boost/laser_extent.h): OpenCV's peer has no\n"
+              "laser layer and no laser extent step, so that part of fusedetd's path is work the peer does not\n"
+              "do; fusedetd runs it on all cores (detection.threads 0), here on one thread like every other\n"
+              "1-thread row\n");
   std::printf("load average after: %s\n", loadAverage().c_str());
   std::printf("bench: detect3_identical_to_per_class %d\n", same == models.size() ? 1 : 0);
   std::printf("bench: detect3_previous_ms %.3f\n", prev);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// bench_mpi_round: scale-out of one boosting round (boost/sharded_stage.h) over MPI ranks, 1 vs 2
+// bench_mpi_round: scale-out of one boosting round (fusedet/boost/sharded_stage.h) over MPI ranks, 1 vs 2
 // ranks on equal terms (one thread per rank, same samples, same pool), with the payload each rank
 // hands to MPI per round. Samples: OpenCV's default pool (grid 24, types a-e, 162,336 features) on
 // intensity windows of the shared KITTI drives (car boxes + mirrored copies, label-free windows),

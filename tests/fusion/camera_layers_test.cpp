@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The hue layer's mask (fusion/camera_layers.h) on hand-made pixels with known answers.
+// The hue layer's mask (fusedet/fusion/camera_layers.h) on hand-made pixels with known answers.
 #include <gtest/gtest.h>
 
 #include <opencv2/core.hpp>

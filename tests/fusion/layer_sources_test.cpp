@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Layer sources (fusion/layer_sources.h): every paper pool layer has a source, and
+// Layer sources (fusedet/fusion/layer_sources.h): every paper pool layer has a source, and
 // weight shares sum per source.
 #include <gtest/gtest.h>
 

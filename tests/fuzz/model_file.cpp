@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// libFuzzer target: a cascade model file (boost/model_io.h). modelFromText may only return a
+// libFuzzer target: a cascade model file (fusedet/boost/model_io.h). modelFromText may only return a
 // cascade or throw ModelError naming the place; an accepted model is written again and must read
 // back to the same text.
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // `fusedet demo` and `fusedet detect` detect as fusedetd does: car grouped with its own settings
-// (boost/class_detection.h) on a real KITTI frame. The expected detections are computed here with
+// (fusedet/boost/class_detection.h) on a real KITTI frame. The expected detections are computed here with
 // detectPerClass() and a car grouping built in this test from classDetectionDefault("car") - not
 // with the classGroupings() the commands use - and the frame is one where car's settings change
 // car's detections, so a command that grouped car with the general settings fails.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Laser-extent box refinement (boost/laser_extent.h) on distance layers drawn by hand; the expected
+// Laser-extent box refinement (fusedet/boost/laser_extent.h) on distance layers drawn by hand; the expected
 // boxes are worked out from the rule in the comments.
 
 #include "fusedet/boost/laser_extent.h"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// Paired comparisons of two runs (boost/paired_comparison.h) and their outcomes.json files
-// (boost/outcomes_file.h) on small outcomes whose F and AP are worked out by hand in the comments.
+// Paired comparisons of two runs (fusedet/boost/paired_comparison.h) and their outcomes.json files
+// (fusedet/boost/outcomes_file.h) on small outcomes whose F and AP are worked out by hand in the comments.
 
 #include <gtest/gtest.h>
 
