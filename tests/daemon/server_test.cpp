@@ -18,6 +18,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <thread>
 
 #include "fusedet/daemon/client.h"
@@ -334,6 +335,43 @@ std::string firstLineAs(const std::string& path, uid_t uid, gid_t gid, const std
   ::waitpid(pid, &status, 0);
   return line.substr(0, line.find('\n'));
 }
+
+constexpr gid_t kRobots = 31337;  // the one group of allow_groups in the access tests
+
+// A server on `path` whose socket file lets anyone connect, so that allow_groups alone decides,
+// and that serves only group kRobots (and root and its own user). Not started.
+std::unique_ptr<Server> robotsOnlyServer(const std::string& path) {
+  ServerLimits limits;
+  limits.allowGroups = {{"robots", kRobots}};
+  SocketAccess everyone;
+  everyone.mode = 0666;
+  return std::make_unique<Server>(bindUnixSocket(path, everyone), limits, Server::Handlers{});
+}
+
+// One byte carrying a file descriptor (SCM_RIGHTS) over a Unix socket pair; fd < 0 = to receive.
+struct FdMessage {
+  explicit FdMessage(int fd = -1) {
+    msg.msg_iov = &io;
+    msg.msg_iovlen = 1;
+    msg.msg_control = control;
+    msg.msg_controllen = sizeof control;
+    if (fd < 0) return;
+    cmsghdr* cm = CMSG_FIRSTHDR(&msg);
+    cm->cmsg_level = SOL_SOCKET;
+    cm->cmsg_type = SCM_RIGHTS;
+    cm->cmsg_len = CMSG_LEN(sizeof(int));
+    std::memcpy(CMSG_DATA(cm), &fd, sizeof fd);
+  }
+  int fd() {
+    int out = -1;
+    if (CMSG_FIRSTHDR(&msg)) std::memcpy(&out, CMSG_DATA(CMSG_FIRSTHDR(&msg)), sizeof out);
+    return out;
+  }
+  char byte = 'f';
+  iovec io{&byte, 1};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
+  msghdr msg{};
+};
 }  // namespace
 
 // Issue 37, who may talk to the socket: the peer's pid/uid/gid (SO_PEERCRED) is known per
@@ -342,12 +380,8 @@ std::string firstLineAs(const std::string& path, uid_t uid, gid_t gid, const std
 TEST(ServerAccess, PeersAreKnownAndAllowGroupsRefusesOthers) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root: the refused client is a child dropped to uid 65534";
   const std::string path = tempSocket("access.sock");
-  constexpr gid_t kAllowed = 31337;
-  ServerLimits limits;
-  limits.allowGroups = {{"robots", kAllowed}};
-  SocketAccess everyone;
-  everyone.mode = 0666;  // the file lets anyone in: allow_groups alone decides
-  Server server(bindUnixSocket(path, everyone), limits, {});
+  auto owned = robotsOnlyServer(path);
+  Server& server = *owned;
   server.start();
   Client self(path);
   self.send({{"cmd", "subscribe"}});
@@ -368,7 +402,7 @@ TEST(ServerAccess, PeersAreKnownAndAllowGroupsRefusesOthers) {
   EXPECT_EQ(server.counters().refusedNotAllowed, 1u);
 
   // A member through a supplementary group is served.
-  const std::string member = firstLineAs(path, 65534, 65534, {kAllowed});
+  const std::string member = firstLineAs(path, 65534, 65534, {kRobots});
   const auto hello = nlohmann::json::parse(member, nullptr, false);
   ASSERT_TRUE(hello.is_object()) << member;
   EXPECT_EQ(hello["type"], "hello");
@@ -383,12 +417,8 @@ TEST(ServerAccess, PeersAreKnownAndAllowGroupsRefusesOthers) {
 TEST(ServerAccess, AllowGroupsUsesTheGroupsAtConnectNotProc) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root: the client is a child dropped to uid 65534";
   const std::string path = tempSocket("peergroups.sock");
-  constexpr gid_t kAllowed = 31337;
-  ServerLimits limits;
-  limits.allowGroups = {{"robots", kAllowed}};
-  SocketAccess everyone;
-  everyone.mode = 0666;
-  Server server(bindUnixSocket(path, everyone), limits, {});  // not started: connections queue
+  auto owned = robotsOnlyServer(path);  // not started: connections queue
+  Server& server = *owned;
   int pair[2];
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM, 0, pair), 0);
   sockaddr_un addr{};
@@ -396,39 +426,19 @@ TEST(ServerAccess, AllowGroupsUsesTheGroupsAtConnectNotProc) {
   std::memcpy(addr.sun_path, path.c_str(), path.size() + 1);
   const pid_t pid = ::fork();
   if (pid == 0) {
-    const gid_t groups[] = {kAllowed};
+    const gid_t groups[] = {kRobots};
     if (::setgroups(1, groups) != 0 || ::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
     const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
     if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0) ::_exit(3);
-    char byte = 'f';
-    iovec io{&byte, 1};
-    alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
-    msghdr msg{};
-    msg.msg_iov = &io;
-    msg.msg_iovlen = 1;
-    msg.msg_control = control;
-    msg.msg_controllen = sizeof control;
-    cmsghdr* cm = CMSG_FIRSTHDR(&msg);
-    cm->cmsg_level = SOL_SOCKET;
-    cm->cmsg_type = SCM_RIGHTS;
-    cm->cmsg_len = CMSG_LEN(sizeof(int));
-    std::memcpy(CMSG_DATA(cm), &fd, sizeof fd);
-    ::_exit(::sendmsg(pair[1], &msg, 0) == 1 ? 0 : 4);
+    FdMessage out(fd);
+    ::_exit(::sendmsg(pair[1], &out.msg, 0) == 1 ? 0 : 4);
   }
   ::close(pair[1]);
-  char byte = 0;
-  iovec io{&byte, 1};
-  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(int))] = {};
-  msghdr msg{};
-  msg.msg_iov = &io;
-  msg.msg_iovlen = 1;
-  msg.msg_control = control;
-  msg.msg_controllen = sizeof control;
-  ASSERT_EQ(::recvmsg(pair[0], &msg, 0), 1);
+  FdMessage in;
+  ASSERT_EQ(::recvmsg(pair[0], &in.msg, 0), 1);
   ::close(pair[0]);
-  int client = -1;
-  ASSERT_NE(CMSG_FIRSTHDR(&msg), nullptr);
-  std::memcpy(&client, CMSG_DATA(CMSG_FIRSTHDR(&msg)), sizeof client);
+  const int client = in.fd();
+  ASSERT_GE(client, 0);
   int status = 0;
   ASSERT_EQ(::waitpid(pid, &status, 0), pid);
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child status " << status;
