@@ -59,3 +59,6 @@ endfunction()
 
 get_filename_component(_default_data "${PROJECT_SOURCE_DIR}/../shared/data" ABSOLUTE)
 set(FUSEDET_DATA_DIR "${_default_data}" CACHE PATH "Root of the shared KITTI data (kitti/, kitti_0009/, ...)")
+get_filename_component(_default_networks "${PROJECT_SOURCE_DIR}/../shared/models" ABSOLUTE)
+set(FUSEDET_NETWORKS_DIR "${_default_networks}" CACHE PATH
+    "Pretrained COCO detector files (Yolo-Fastest-XL, YOLOv5n: read at run time, never copied into the repository)")

@@ -60,6 +60,21 @@ NetworkKind parseNetworkKind(std::string_view text) {
   throw std::invalid_argument("unknown network kind '" + std::string(text) + "' (darknet, yolov5-onnx)");
 }
 
+cv::Size parseInputSize(std::string_view text) {
+  const std::size_t x = text.find('x');
+  int w = 0, h = 0;
+  const auto number = [](std::string_view t, int& v) {
+    if (t.empty() || t.size() > 5) return false;
+    for (char c : t)
+      if (c < '0' || c > '9') return false;
+    v = std::stoi(std::string(t));
+    return v > 0;
+  };
+  if (x == std::string_view::npos || !number(text.substr(0, x), w) || !number(text.substr(x + 1), h))
+    throw std::invalid_argument("network input size '" + std::string(text) + "': expected WxH in pixels, e.g. 832x256");
+  return {w, h};
+}
+
 std::string toString(NetworkKind kind) { return kind == NetworkKind::darknet ? "darknet" : "yolov5-onnx"; }
 
 std::string NetworkIdentity::text() const {

@@ -30,6 +30,8 @@ enum class NetworkKind { darknet, yolov5Onnx };
 // "darknet" | "yolov5-onnx"; throws std::invalid_argument naming the accepted kinds.
 NetworkKind parseNetworkKind(std::string_view text);
 std::string toString(NetworkKind kind);
+// "832x256" (W x H, pixels) -> the size; throws std::invalid_argument naming the text otherwise.
+cv::Size parseInputSize(std::string_view text);
 
 struct NetworkSpec {
   NetworkKind kind = NetworkKind::yolov5Onnx;
