@@ -80,7 +80,9 @@ class Section {
     fail(node_ ? node_[key] : node_, msg.str());
   }
 
-  YAML::Node at(const char* key) const { return node_ && node_.IsMap() ? node_[key] : YAML::Node(); }
+  // Undefined (false) when the section or key is absent; YAML::Node() would be a defined null
+  // (true), and an absent detection section would then clear the built-in detection.classes.
+  YAML::Node at(const char* key) const { return node_ && node_.IsMap() ? node_[key] : YAML::Node(YAML::NodeType::Undefined); }
 
   // The entries of the mapping under `key` (name, its section), in file order; marks `key` read.
   std::vector<std::pair<std::string, Section>> entries(const char* key) {

@@ -28,6 +28,12 @@ TEST(Config, ShippedFileParsesAndEqualsTheDefaults) {
 
 TEST(Config, EmptyFileGivesDefaultsAndDumpRoundTrips) {
   const Config c = parseConfig("", "empty.yaml");
+  // every key at its default, the built-in detection.classes too (a sensor log's rig has no
+  // detection section: its car was detected with 3 neighbours instead of 16 before)
+  EXPECT_EQ(dumpConfig(c), dumpConfig(Config{}));
+  ASSERT_EQ(c.detection.classes.size(), 1u);
+  EXPECT_EQ(c.detection.classes[0].minNeighbors, 16);
+  EXPECT_EQ(dumpConfig(parseConfig("version: 1\nlaser:\n  baud: 500000\n", "rig.yaml")).find("classes:\n    {}"), std::string::npos);
   EXPECT_EQ(c.socket.path, "/run/fusedet/fusedet.sock");
   Config changed = c;
   changed.laser.baud = 500000;
