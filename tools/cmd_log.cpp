@@ -39,9 +39,10 @@ int runDerive(const LogOptions& o) {
               static_cast<std::uintmax_t>(r.points));
   std::string classes;
   for (const std::string& c : r.classes) classes += " " + c;
-  std::printf("camera   %ju frames, %ju fused stacks%s, %ju detections (classes:%s)\n", static_cast<std::uintmax_t>(r.frames),
-              static_cast<std::uintmax_t>(r.stacks), r.calibrated ? "" : " (no camera calibration in the log)",
-              static_cast<std::uintmax_t>(r.detections), classes.empty() ? " none" : classes.c_str());
+  std::printf("camera   %ju frames, %ju stacks%s, %ju detections (classes:%s), %ju tracks messages\n",
+              static_cast<std::uintmax_t>(r.frames), static_cast<std::uintmax_t>(r.stacks),
+              r.calibrated ? "" : " (no camera calibration in the log)", static_cast<std::uintmax_t>(r.detections),
+              classes.empty() ? " none" : classes.c_str(), static_cast<std::uintmax_t>(r.trackMessages));
   return 0;
 }
 
@@ -102,9 +103,11 @@ const bool registered = registerCommand(
           "detectors, configured from the rig IN carries, and writes OUT = IN's raw channels and metadata plus\n"
           "/lms291/scan (foxglove.LaserScan, frame laser), /tilt/sample, /tf (foxglove.FrameTransform: laser_base ->\n"
           "laser at every tilt sample, laser_base -> camera with every frame), /camera/calibration\n"
-          "(foxglove.CameraCalibration), /sweep/points (foxglove.PointCloud, frame laser_base) and /detections\n"
-          "(foxglove.ImageAnnotations on the camera image, stamped like the frame): open OUT in Foxglove to see the\n"
-          "camera with its detections and the sweeps in 3D. Derived channels IN had are computed again, not copied.\n"
+          "(foxglove.CameraCalibration), /sweep/points (foxglove.PointCloud, frame laser_base), /detections\n"
+          "(foxglove.ImageAnnotations on the camera image, stamped like the frame), /tracks (the tracks lines of the\n"
+          "socket) and /tracks/scene (foxglove.SceneUpdate: an entity track-N per live track, frame laser_base);\n"
+          "detections and tracks are fusedetd's pipeline run on IN with the models: open OUT in Foxglove to see the\n"
+          "camera with its detections and the sweeps and tracks in 3D. Derived channels IN had are computed again.\n"
           "Examples:\n"
           "  fusedet log info run.mcap\n"
           "  fusedet log export run.mcap --candump tilt.log && log2asc -I tilt.log -O tilt.asc can0\n"

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // fusedet replay: a sensor log through fusedetd's pipeline as fast as the machine allows, writing
-// the `detections` lines a subscribed socket client would get (docs/protocol.md), one per stack.
+// the `detections` lines a subscribed socket client would get (docs/protocol.md), one per stack,
+// and with --tracks the `tracks` lines of the tracks stream.
 // The work is fusedet/daemon/offline_replay.h; this file parses and prints.
 
 #include <chrono>
@@ -19,6 +20,7 @@ struct ReplayOptions {
   std::string log;
   std::string config;
   std::string out;
+  std::string tracks;  // also the tracks lines, to this file
 };
 
 int runReplay(const ReplayOptions& o) {
@@ -30,11 +32,19 @@ int runReplay(const ReplayOptions& o) {
   const daemon::Config config = daemon::loadConfig(configFile);
   std::ofstream out(o.out, std::ios::binary | std::ios::trunc);
   if (!out) throw std::runtime_error(o.out + ": cannot open for writing");
+  std::ofstream tracks;
+  if (!o.tracks.empty()) {
+    tracks.open(o.tracks, std::ios::binary | std::ios::trunc);
+    if (!tracks) throw std::runtime_error(o.tracks + ": cannot open for writing");
+  }
   const auto t0 = std::chrono::steady_clock::now();
-  const daemon::OfflineReplayReport report = daemon::replayOffline(
-      config, configFile, o.log, [&out](const daemon::StackResult& r) { out << daemon::toLine(daemon::resultToJson(r)); });
+  const daemon::OfflineReplayReport report = daemon::replayOffline(config, configFile, o.log, [&](const daemon::StackResult& r) {
+    out << daemon::toLine(daemon::resultToJson(r));
+    if (tracks.is_open()) tracks << daemon::toLine(daemon::tracksToJson(r));
+  });
   out.flush();
   if (!out) throw std::runtime_error(o.out + ": write failed");
+  if (tracks.is_open() && !tracks.flush()) throw std::runtime_error(o.tracks + ": write failed");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const daemon::PipelineCounters& c = report.counters;
   std::fprintf(stderr, "%s: %llu stacks, %llu detections in %.1f s (%.1f stacks/s); %llu unpaired sweeps, %llu errors -> %s\n",
@@ -53,6 +63,7 @@ const bool registered = registerCommand(
       app.add_option("-c,--config", o->config,
                      "daemon config (detection, models, tracking; default: the installation's, as fusedetd)");
       app.add_option("-o,--out", o->out, "NDJSON file for the detections lines")->required();
+      app.add_option("--tracks", o->tracks, "NDJSON file for the tracks lines (one per stack, as the tracks stream sends them)");
       app.footer(
           "Runs the log through the same code as fusedetd with replay.file set (the log's rig, this\n"
           "config's detection, models and tracking; fusedet/daemon/offline_replay.h), as fast as\n"

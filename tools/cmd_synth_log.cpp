@@ -43,10 +43,10 @@ int run(SynthCliOptions o) {
   if (o.derived) {
     const sensor_logs::DeriveReport d = sensor_logs::deriveLog(raw, o.out, sensor_logs::DeriveOptions{models});
     fs::remove(raw);
-    std::printf("derived  %ju scans, %ju sweeps (%ju points), %ju stacks, %ju detections, %ju transforms\n",
+    std::printf("derived  %ju scans, %ju sweeps (%ju points), %ju stacks, %ju detections, %ju tracks messages, %ju transforms\n",
                 static_cast<std::uintmax_t>(d.scans), static_cast<std::uintmax_t>(d.sweeps), static_cast<std::uintmax_t>(d.points),
                 static_cast<std::uintmax_t>(d.stacks), static_cast<std::uintmax_t>(d.detections),
-                static_cast<std::uintmax_t>(d.transforms));
+                static_cast<std::uintmax_t>(d.trackMessages), static_cast<std::uintmax_t>(d.transforms));
   }
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf("wrote    %s (%ju bytes) in %.2f s\n", o.out.c_str(), static_cast<std::uintmax_t>(fs::file_size(o.out)), took);

@@ -60,13 +60,30 @@ const std::string& schemaText(Schema s) {
       object("foxglove.CameraCalibration", R"("frame_id":{"type":"string"},"width":{"type":"integer"},"height":{"type":"integer"},)"
                                            R"("distortion_model":{"type":"string"},"D":)" + kNumberArray + R"(,"K":)" + kNumberArray +
                                            R"(,"R":)" + kNumberArray + R"(,"P":)" + kNumberArray),
+      object("fusedet.Tracks", R"("type":{"type":"string"},"stack":{"type":"integer"},"frame_ns":{"type":"integer"},)"
+                               R"("sensor_ns":{"type":"integer"},"detected_ns":{"type":"integer"},"tracks":{"type":"array","items":)"
+                               R"({"type":"object","properties":{"id":{"type":"integer"},"class":{"type":"string"},)"
+                               R"("confirmed":{"type":"boolean"},"coasting":{"type":"boolean"},"robot":)" + kNumberArray +
+                               R"(,"velocity":)" + kNumberArray + R"(,"sigma":{"type":"number"},"age":{"type":"number"},)"
+                               R"("hits":{"type":"integer"},"misses":{"type":"integer"},"box":)" + kNumberArray + "}}}"),
+      std::string(R"({"title":"foxglove.SceneUpdate","type":"object","properties":{"deletions":{"type":"array","items":{"type":"object","properties":{)") +
+          kTimeProp + R"(,"type":{"type":"integer"},"id":{"type":"string"}}}},"entities":{"type":"array","items":{"type":"object","properties":{)" +
+          kTimeProp + R"(,"frame_id":{"type":"string"},"id":{"type":"string"},"lifetime":{"type":"object","properties":{"sec":{"type":"integer"},)"
+          R"("nsec":{"type":"integer"}}},"frame_locked":{"type":"boolean"},"metadata":{"type":"array","items":{"type":"object",)"
+          R"("properties":{"key":{"type":"string"},"value":{"type":"string"}}}},)"
+          R"("spheres":{"type":"array","items":{"type":"object","properties":{)" + pose() + R"(,"size":)" + kVec3 + R"(,"color":)" + kColor + "}}},"
+          R"("arrows":{"type":"array","items":{"type":"object","properties":{)" + pose() + R"(,"shaft_length":{"type":"number"},)"
+          R"("shaft_diameter":{"type":"number"},"head_length":{"type":"number"},"head_diameter":{"type":"number"},"color":)" + kColor + "}}},"
+          R"("texts":{"type":"array","items":{"type":"object","properties":{)" + pose() + R"(,"billboard":{"type":"boolean"},)"
+          R"("font_size":{"type":"number"},"scale_invariant":{"type":"boolean"},"color":)" + kColor + R"(,"text":{"type":"string"}}}},)"
+          R"("cubes":{"type":"array"},"cylinders":{"type":"array"},"lines":{"type":"array"},"triangles":{"type":"array"},"models":{"type":"array"}}}}}})",
   };
   return texts[static_cast<int>(s)];
 }
 
 json timestamp(Stamp s) {
-  const std::int64_t sec = s.ns >= 0 ? s.ns / 1'000'000'000 : -((-s.ns + 999'999'999) / 1'000'000'000);
-  return json{{"sec", sec}, {"nsec", s.ns - sec * 1'000'000'000}};
+  const SecNsec t = secNsec(s);
+  return json{{"sec", t.sec}, {"nsec", t.nsec}};
 }
 
 std::vector<std::uint8_t> bytesOf(const json& j) {
@@ -172,11 +189,16 @@ constexpr double kBearingOffset = M_PI / 2;
 
 }  // namespace
 
+SecNsec secNsec(Stamp s) {
+  const std::int64_t sec = s.ns >= 0 ? s.ns / 1'000'000'000 : -((-s.ns + 999'999'999) / 1'000'000'000);
+  return {sec, s.ns - sec * 1'000'000'000};
+}
+
 std::string_view schemaName(Schema s) {
   static constexpr std::string_view names[] = {"fusedet.RawSerial", "fusedet.CanFrame", "foxglove.RawImage",
                                                "foxglove.CompressedImage", "foxglove.LaserScan", "fusedet.TiltSample",
                                                "foxglove.PointCloud", "foxglove.ImageAnnotations", "foxglove.FrameTransform",
-                                               "foxglove.CameraCalibration"};
+                                               "foxglove.CameraCalibration", "fusedet.Tracks", "foxglove.SceneUpdate"};
   return names[static_cast<int>(s)];
 }
 std::string_view schemaJson(Schema s) { return schemaText(s); }
@@ -273,6 +295,50 @@ std::vector<std::uint8_t> encode(const TransformMessage& m) {
   return bytesOf(json{{"timestamp", timestamp(m.stamp)}, {"parent_frame_id", m.parent}, {"child_frame_id", m.child},
                       {"translation", {{"x", t[0]}, {"y", t[1]}, {"z", t[2]}}},
                       {"rotation", {{"x", q[0]}, {"y", q[1]}, {"z", q[2]}, {"w", q[3]}}}});
+}
+
+namespace {
+json vec3(const std::array<double, 3>& v) { return json{{"x", v[0]}, {"y", v[1]}, {"z", v[2]}}; }
+json colourOf(const std::array<double, 4>& c) { return json{{"r", c[0]}, {"g", c[1]}, {"b", c[2]}, {"a", c[3]}}; }
+json poseAt(const std::array<double, 3>& p, const std::array<double, 4>& q = {0, 0, 0, 1}) {
+  return json{{"position", vec3(p)}, {"orientation", {{"x", q[0]}, {"y", q[1]}, {"z", q[2]}, {"w", q[3]}}}};
+}
+// The rotation (quaternion x y z w) that turns +x, the direction a foxglove.ArrowPrimitive points
+// in, onto the unit vector u: about x cross u by the angle between them.
+std::array<double, 4> turnXOnto(const std::array<double, 3>& u) {
+  if (u[0] < -1 + 1e-9) return {0, 0, 1, 0};  // opposite: half a turn about z
+  const double w = 1 + u[0], n = std::sqrt(w * w + u[1] * u[1] + u[2] * u[2]);
+  return {0, -u[2] / n, u[1] / n, w / n};
+}
+}  // namespace
+
+std::vector<std::uint8_t> encode(const SceneUpdateMessage& m) {
+  constexpr int kDeleteAll = 1;             // foxglove.SceneEntityDeletionType ALL
+  constexpr double kMinArrowSpeed = 0.05;   // [m/s] slower: no arrow
+  const json lifetime = timestamp(Stamp{static_cast<std::int64_t>(std::llround(m.lifetimeS * 1e9))});
+  json entities = json::array();
+  for (const SceneObject& o : m.objects) {
+    json metadata = json::array();
+    for (const auto& [k, v] : o.metadata) metadata.push_back({{"key", k}, {"value", v}});
+    const double speed = std::hypot(o.velocity[0], o.velocity[1], o.velocity[2]);
+    json arrows = json::array();
+    if (speed >= kMinArrowSpeed)
+      arrows.push_back({{"pose", poseAt(o.position, turnXOnto({o.velocity[0] / speed, o.velocity[1] / speed, o.velocity[2] / speed}))},
+                        {"shaft_length", speed * 1.0}, {"shaft_diameter", 0.08}, {"head_length", 0.3}, {"head_diameter", 0.25},
+                        {"color", colourOf(o.colour)}});
+    const std::array<double, 3> above{o.position[0], o.position[1], o.position[2] + o.diameter / 2 + 0.3};
+    entities.push_back({{"timestamp", timestamp(m.stamp)}, {"frame_id", m.frame}, {"id", o.id}, {"lifetime", lifetime},
+                        {"frame_locked", false}, {"metadata", metadata}, {"arrows", arrows},
+                        {"spheres", json::array({{{"pose", poseAt(o.position)},
+                                                  {"size", vec3({o.diameter, o.diameter, o.diameter})},
+                                                  {"color", colourOf(o.colour)}}})},
+                        {"texts", json::array({{{"pose", poseAt(above)}, {"billboard", true}, {"font_size", 14.0},
+                                                {"scale_invariant", true}, {"color", colourOf(o.colour)}, {"text", o.text}}})},
+                        {"cubes", json::array()}, {"cylinders", json::array()}, {"lines", json::array()},
+                        {"triangles", json::array()}, {"models", json::array()}});
+  }
+  return bytesOf(json{{"deletions", json::array({{{"timestamp", timestamp(m.stamp)}, {"type", kDeleteAll}, {"id", ""}}})},
+                      {"entities", entities}});
 }
 
 Result<SerialChunk> decodeSerial(std::span<const std::uint8_t> bytes) {

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <thread>
 
@@ -179,6 +180,44 @@ TEST(Channels, MalformedMessagesAreErrorsNamingTheProblem) {
   EXPECT_FALSE(decodeCan(span(badId)));
   const std::string badEncoding = R"({"timestamp":{"sec":1,"nsec":0},"width":1,"height":1,"encoding":"rgb16","step":6,"data":""})";
   EXPECT_FALSE(decodeCamera(span(badEncoding)));
+}
+
+// The arrow of a moving object points along its velocity: the encoded quaternion, applied to +x
+// (the arrow's direction in Foxglove) by the rotation formula here, gives velocity / speed; a
+// standing object has none; the lifetime and the delete-all come out as sent.
+TEST(Channels, SceneUpdateArrowsPointAlongTheVelocity) {
+  SceneUpdateMessage m;
+  m.stamp = Stamp{12'500'000'000};
+  m.lifetimeS = 3.25;
+  const std::array<std::array<double, 3>, 5> velocities{{{-2, 0, 0}, {0, 3, 4}, {1, -1, 0.5}, {0.99, 0.001, 0}, {0.01, 0, 0}}};
+  for (std::size_t i = 0; i < velocities.size(); ++i)
+    m.objects.push_back({"track-" + std::to_string(i), "car", {1.0 * i, 2, 0}, velocities[i], 0.5, {1, 0, 0, 1}, {{"id", std::to_string(i)}}});
+  const auto bytes = encode(m);
+  const nlohmann::json j = nlohmann::json::parse(bytes.begin(), bytes.end());
+  ASSERT_EQ(j.at("deletions").size(), 1u);
+  EXPECT_EQ(j["deletions"][0]["type"], 1);  // ALL
+  ASSERT_EQ(j.at("entities").size(), velocities.size());
+  for (std::size_t i = 0; i < velocities.size(); ++i) {
+    const nlohmann::json& e = j["entities"][i];
+    EXPECT_EQ(e["lifetime"]["sec"], 3);
+    EXPECT_EQ(e["lifetime"]["nsec"], 250'000'000);
+    EXPECT_EQ(e["timestamp"]["sec"], 12);
+    EXPECT_EQ(e["spheres"][0]["pose"]["position"]["x"].get<double>(), 1.0 * i);
+    const auto& v = velocities[i];
+    const double speed = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (speed < 0.05) {
+      EXPECT_TRUE(e["arrows"].empty()) << i;
+      continue;
+    }
+    ASSERT_EQ(e["arrows"].size(), 1u) << i;
+    const nlohmann::json& q = e["arrows"][0]["pose"]["orientation"];
+    const double x = q["x"], y = q["y"], z = q["z"], w = q["w"];
+    EXPECT_NEAR(x * x + y * y + z * z + w * w, 1.0, 1e-12) << i;
+    // R(q) e_x = first column of the rotation matrix
+    const double d[3] = {1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y)};
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(d[k], v[static_cast<std::size_t>(k)] / speed, 1e-9) << i << " " << k;
+    EXPECT_NEAR(e["arrows"][0]["shaft_length"].get<double>(), speed, 1e-12);
+  }
 }
 
 TEST(Channels, EverySchemaIsJsonWithItsName) {

@@ -12,12 +12,18 @@
 //    like a camera image (Foxglove draws them on the image with the same stamp).
 // Prints "count TOPIC N" per topic for the calling script to compare with fusedet's own reader.
 // --schemas-only: only the validation (a log with every channel kind but no derived content).
-// Usage: node foxglove_schemas.cjs NODE_PREFIX LOG.mcap [--schemas-only]
+// --tracks FILE: FILE holds the tracks lines `fusedet replay --tracks` wrote for the same raw log
+//   (what the socket's tracks stream sends); each stack's /tracks message must carry the same
+//   tracks and its /tracks/scene entities must draw exactly them: entity id track-N and metadata,
+//   the sphere at the track's position in laser_base, the arrow along its velocity (the quaternion
+//   applied to +x here), the state by colour, a lifetime, the previous entities deleted.
+// Usage: node foxglove_schemas.cjs NODE_PREFIX LOG.mcap [--schemas-only | --tracks FILE]
 "use strict";
 const fs = require("fs");
 const path = require("path");
-const [prefix, logPath, mode] = process.argv.slice(2);
+const [prefix, logPath, mode, tracksPath] = process.argv.slice(2);
 const schemasOnly = mode === "--schemas-only";
+const replayTracks = mode === "--tracks" ? fs.readFileSync(tracksPath, "utf8").split("\n").filter((l) => l).map((l) => JSON.parse(l)) : null;
 const mod = (name) => require(path.join(prefix, "node_modules", name));
 const { McapIndexedReader } = mod("@mcap/core");
 const fzstd = mod("fzstd");
@@ -61,6 +67,7 @@ function foxgloveValidator(name) {
   }
   const counts = {}, bad = {}, frames = {}, encodings = new Set(), tfPairs = new Set(), imageStamps = new Set(), annotationStamps = [];
   let imageSizeOk = true, cloudOk = true, calibOk = true, boxes = 0;
+  const trackLines = [], scenes = [];
   for await (const m of reader.readMessages()) {
     const ch = reader.channelsById.get(m.channelId);
     const schema = reader.schemasById.get(ch.schemaId).name;
@@ -89,6 +96,8 @@ function foxgloveValidator(name) {
     }
     if (schema === "foxglove.FrameTransform") tfPairs.add(`${j.parent_frame_id}->${j.child_frame_id}`);
     if (schema === "foxglove.CameraCalibration") calibOk &&= j.K.length === 9 && j.P.length === 12 && j.K[8] === 1 && j.width > 0;
+    if (ch.topic === "/tracks") trackLines.push({ t: m.logTime, j });
+    if (ch.topic === "/tracks/scene") scenes.push({ t: m.logTime, j });
     if (schema === "foxglove.ImageAnnotations") {
       annotationStamps.push(stamp);
       boxes += j.points.length;
@@ -98,6 +107,7 @@ function foxgloveValidator(name) {
   for (const [k, n] of Object.entries(bad)) check(false, `${n} invalid messages on ${k}`);
   for (const [t, n] of Object.entries(counts).sort()) console.log(`count ${t} ${n}`);
   if (!schemasOnly) derivedChecks();
+  if (replayTracks) trackChecks();
   console.log(`@foxglove/schemas validated ${Object.values(counts).reduce((a, b) => a + b, 0)} messages on ${reader.channelsById.size} channels; ${boxes} detection boxes`);
   if (failures) {
     console.log(`${failures} check(s) failed`);
@@ -108,7 +118,8 @@ function foxgloveValidator(name) {
   function derivedChecks() {
   const want = { "/camera/image": "foxglove.RawImage", "/lms291/scan": "foxglove.LaserScan", "/sweep/points": "foxglove.PointCloud",
                  "/detections": "foxglove.ImageAnnotations", "/tf": "foxglove.FrameTransform",
-                 "/camera/calibration": "foxglove.CameraCalibration", "/lms291/raw": "fusedet.RawSerial", "/tilt/can": "fusedet.CanFrame" };
+                 "/camera/calibration": "foxglove.CameraCalibration", "/lms291/raw": "fusedet.RawSerial", "/tilt/can": "fusedet.CanFrame",
+                 "/tracks": "fusedet.Tracks", "/tracks/scene": "foxglove.SceneUpdate" };
   const topicSchema = {};
   for (const ch of reader.channelsById.values()) topicSchema[ch.topic] = reader.schemasById.get(ch.schemaId).name;
   for (const [t, s] of Object.entries(want)) check(topicSchema[t] === s && counts[t] > 0, `${t}: ${topicSchema[t]} with ${counts[t]} messages, want ${s}`);
@@ -123,6 +134,72 @@ function foxgloveValidator(name) {
   check(calibOk, "calibration K 3x3, P 3x4");
   check(tfPairs.has("laser_base->laser") && tfPairs.has("laser_base->camera"), "transforms: " + [...tfPairs]);
   check(annotationStamps.length > 0 && annotationStamps.every((t) => imageStamps.has(t)), "every annotation stamped like a camera image");
+  }
+
+  function trackChecks() {
+    const ns = (t) => BigInt(t.sec) * 1000000000n + BigInt(t.nsec);
+    const near = (a, b, tol) => Math.abs(a - b) <= tol;
+    // A quaternion applied to a vector: v' = v + 2 w (q x v) + 2 q x (q x v).
+    const rotate = (q, v) => {
+      const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+      const u = [q.x, q.y, q.z], t = cross(u, v).map((c) => 2 * c), ut = cross(u, t);
+      return [0, 1, 2].map((i) => v[i] + q.w * t[i] + ut[i]);
+    };
+    check(trackLines.length === replayTracks.length && scenes.length === replayTracks.length,
+          `tracks messages ${trackLines.length} / scenes ${scenes.length} != ${replayTracks.length} stacks of fusedet replay`);
+    const states = { confirmed: 0, coasting: 0, tentative: 0 }, ids = new Set(), alphaOf = {};
+    let arrows = 0;
+    for (let k = 0; k < Math.min(scenes.length, replayTracks.length, trackLines.length); k++) {
+      const want = replayTracks[k], line = trackLines[k].j, scene = scenes[k].j, at = `stack ${want.stack}`;
+      check(BigInt(want.frame_ns) === trackLines[k].t && BigInt(want.frame_ns) === scenes[k].t, `${at}: log time != the replay's frame_ns`);
+      // /tracks carries the socket's line (detected_ns is when this run detected it).
+      const strip = (x) => JSON.stringify({ ...x, detected_ns: 0, timestamp: undefined });
+      check(strip(line) === strip(want), `${at}: /tracks differs from the replay's tracks line`);
+      check(scene.deletions.length === 1 && scene.deletions[0].type === 1 && ns(scene.deletions[0].timestamp) === trackLines[k].t,
+            `${at}: the scene does not first delete every earlier entity`);
+      const byId = new Map(scene.entities.map((e) => [e.id, e]));
+      check(byId.size === want.tracks.length && scene.entities.length === want.tracks.length,
+            `${at}: ${scene.entities.length} entities for ${want.tracks.length} tracks`);
+      for (const t of want.tracks) {
+        const e = byId.get(`track-${t.id}`);
+        if (!e) {
+          check(false, `${at}: no entity track-${t.id}`);
+          continue;
+        }
+        ids.add(t.id);
+        const meta = Object.fromEntries(e.metadata.map((kv) => [kv.key, kv.value]));
+        const state = !t.confirmed ? "tentative" : t.coasting ? "coasting" : "confirmed";
+        states[state]++;
+        check(e.frame_id === "laser_base" && ns(e.timestamp) === scenes[k].t, `${at} track ${t.id}: frame ${e.frame_id} or stamp`);
+        check(meta.id === String(t.id) && meta.class === t.class && meta.state === state, `${at} track ${t.id}: metadata ${JSON.stringify(meta)}`);
+        check(e.texts.length === 1 && e.texts[0].text.startsWith(`${t.class} ${t.id}`), `${at} track ${t.id}: text`);
+        const v = meta.velocity.split(" ").map(Number);
+        check(v.length === 3 && v.every((x, i) => near(x, t.velocity[i], 6e-4)), `${at} track ${t.id}: metadata velocity ${meta.velocity} vs ${t.velocity}`);
+        const p = e.spheres[0].pose.position;
+        check(e.spheres.length === 1 && near(p.x, t.robot[0], 1e-9) && near(p.y, t.robot[1], 1e-9) && near(p.z, t.robot[2], 1e-9),
+              `${at} track ${t.id}: sphere at ${JSON.stringify(p)}, track at ${t.robot}`);
+        const lifetime = e.lifetime.sec + e.lifetime.nsec * 1e-9;
+        check(near(lifetime, 3.0, 1e-9), `${at} track ${t.id}: lifetime ${lifetime} s, want tracking.max_coast_s (3 s)`);
+        const speed = Math.hypot(...t.velocity);
+        if (speed >= 0.05) {
+          arrows++;
+          const a = e.arrows[0], dir = a ? rotate(a.pose.orientation, [1, 0, 0]) : [0, 0, 0];
+          check(e.arrows.length === 1 && dir.every((d, i) => near(d, t.velocity[i] / speed, 1e-6)) && near(a.shaft_length, speed, 1e-9),
+                `${at} track ${t.id}: arrow ${dir} vs velocity ${t.velocity}`);
+        } else {
+          check(e.arrows.length === 0, `${at} track ${t.id}: an arrow for a standing track`);
+        }
+        const c = e.spheres[0].color;
+        (alphaOf[state] = alphaOf[state] || new Set()).add(`${c.r},${c.g},${c.b},${c.a}` + (state === "tentative" ? "" : `/${t.class}`));
+      }
+    }
+    // The three states look different: tentative grey, coasting translucent, confirmed opaque.
+    const colours = (s) => [...(alphaOf[s] || [])];
+    check(colours("tentative").every((c) => c.startsWith("0.6,0.6,0.6,")), "tentative tracks are grey");
+    check(colours("coasting").every((c) => c.split(",")[3].startsWith("0.3")), "coasting tracks are translucent");
+    check(colours("confirmed").every((c) => c.split(",")[3].startsWith("1/")), "confirmed tracks are opaque");
+    console.log(`tracks agree with fusedet replay: ${scenes.length} stacks, ${ids.size} track ids, ` +
+                `${states.confirmed} confirmed, ${states.coasting} coasting, ${states.tentative} tentative entities, ${arrows} arrows`);
   }
 })().catch((e) => {
   console.log("FAIL exception: " + (e && e.stack ? e.stack : e));

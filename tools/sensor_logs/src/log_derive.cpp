@@ -5,15 +5,15 @@
 #include <stdexcept>
 
 #include "fusedet/daemon/config.h"
+#include "fusedet/daemon/offline_replay.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/daemon/stack_detector.h"
 #include "fusedet/drivers/log/recorder.h"
 #include "fusedet/drivers/log/replay.h"
 #include "fusedet/fusion/camera_model.h"
-#include "fusedet/fusion/frame_decode.h"
-#include "fusedet/fusion/fuser.h"
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
+#include "fusedet/sensor_logs/track_channels.h"
 
 namespace fusedet::sensor_logs {
 
@@ -71,23 +71,16 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   const Eigen::Isometry3d laserToCamera = daemon::laserToCamera(config);
 
   std::optional<fusion::CameraModel> camera;
-  std::optional<fusion::Fuser> fuser;
   if (!rig->cameraYaml.empty()) {
     camera = fusion::parseCameraModel(rig->cameraYaml, in.string() + ":camera.yaml");
-    fusion::ProjectionConfig projection;
-    projection.laserLayerScale = config.fusion.laserLayerScale;
-    projection.holeFillRadius = config.fusion.holeFillRadius;
-    fuser.emplace(*camera, laserToCamera, projection);
     report.calibrated = true;
   }
-  std::unique_ptr<daemon::CascadeSet> detector;
-  if (!options.models.empty()) {
-    daemon::Config::Detection d = config.detection;
-    d.models.clear();
-    for (const auto& m : options.models) d.models.push_back(m.string());
-    detector = std::make_unique<daemon::CascadeSet>(d);
-    report.classes = detector->classes();
-  }
+  // The stacks' detections and tracks come from the daemon's own pipeline (offline_replay.h) with
+  // the rig's config and these models: the log shows what fusedetd would send.
+  daemon::Config pipelineConfig = config;
+  pipelineConfig.detection.models.clear();
+  for (const auto& m : options.models) pipelineConfig.detection.models.push_back(std::filesystem::absolute(m).string());
+  if (!options.models.empty()) report.classes = daemon::CascadeSet(pipelineConfig.detection).classes();
 
   // Pass 1: replay IN and compute the derived messages.
   std::vector<Derived> derived;
@@ -106,20 +99,7 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
       ++report.sweeps;
       report.points += s.points.size();
       keep(s.end, logs::topic::kSweep, logs::Schema::kPointCloud, logs::encode(cloud));
-      if (!fuser) continue;
-      auto frame = pairer.pair(s);
-      if (!frame) continue;
-      auto bgr = fusion::decodeCameraFrame(*frame);
-      if (!bgr) continue;  // an undecodable frame: no stack (as the live pipeline)
-      LayerStack stack = fuser->fuse(*bgr, s);
-      stack.stamp = frame->stamp;
-      ++report.stacks;
-      if (!detector) continue;
-      logs::AnnotationsMessage a{frame->stamp, {}};
-      for (const Detection& d : detector->detect(stack))
-        a.boxes.push_back({d.className, d.score, d.box.x, d.box.y, d.box.w, d.box.h});
-      report.detections += a.boxes.size();
-      keep(frame->stamp, logs::topic::kDetections, logs::Schema::kImageAnnotations, logs::encode(a));
+      if (camera && pairer.pair(s)) ++report.stacks;
     }
   };
   logs::SensorReplay::Handlers h;
@@ -150,6 +130,22 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   while (replay.step(h)) takeSweeps();
   sweeps.flush();
   takeSweeps();
+  if (camera && !options.models.empty()) {
+    const daemon::OfflineReplayReport r = daemon::replayOffline(pipelineConfig, in, in, [&](const daemon::StackResult& stack) {
+      logs::AnnotationsMessage a{stack.frameStamp, {}};
+      for (const daemon::LocatedDetection& ld : stack.detections) {
+        const Detection& d = ld.detection;
+        a.boxes.push_back({d.className, d.score, d.box.x, d.box.y, d.box.w, d.box.h});
+      }
+      report.detections += a.boxes.size();
+      keep(stack.frameStamp, logs::topic::kDetections, logs::Schema::kImageAnnotations, logs::encode(a));
+      keep(stack.frameStamp, logs::topic::kTracks, logs::Schema::kTracks, tracksMessage(stack));
+      keep(stack.frameStamp, logs::topic::kTrackScene, logs::Schema::kSceneUpdate,
+           logs::encode(trackScene(stack, pipelineConfig.tracking.maxCoastS)));
+      report.trackMessages += 2;
+    });
+    report.stacks = r.counters.stacksDetected;
+  }
   std::stable_sort(derived.begin(), derived.end(), [](const Derived& a, const Derived& b) { return a.t < b.t; });
 
   // Pass 2: OUT = IN's metadata and raw messages, with the derived ones merged in by time.

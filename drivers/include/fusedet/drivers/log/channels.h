@@ -12,6 +12,7 @@
 //   /lms291/scan     foxglove.LaserScan      /tilt/sample  fusedet.TiltSample
 //   /sweep/points    foxglove.PointCloud     /detections   foxglove.ImageAnnotations
 //   /tf              foxglove.FrameTransform  /camera/calibration foxglove.CameraCalibration
+//   /tracks          fusedet.Tracks          /tracks/scene foxglove.SceneUpdate
 // Metadata record "fusedet.config": "config.yaml" (fusedet.yaml format), "camera.yaml" (ROS
 // camera_info); see docs/log-format.md.
 
@@ -21,6 +22,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "fusedet/core/result.h"
@@ -39,6 +41,8 @@ inline constexpr char kSweep[] = "/sweep/points";
 inline constexpr char kDetections[] = "/detections";
 inline constexpr char kTransforms[] = "/tf";
 inline constexpr char kCameraCalibration[] = "/camera/calibration";
+inline constexpr char kTracks[] = "/tracks";           // the socket's tracks line per stack
+inline constexpr char kTrackScene[] = "/tracks/scene";  // one 3D entity per live track
 }  // namespace topic
 
 // Metadata record names and keys.
@@ -49,12 +53,12 @@ inline constexpr char kRecordingMetadata[] = "fusedet.recording";
 
 enum class Schema {
   kRawSerial, kCanFrame, kRawImage, kCompressedImage, kLaserScan, kTiltSample, kPointCloud,
-  kImageAnnotations, kFrameTransform, kCameraCalibration,
+  kImageAnnotations, kFrameTransform, kCameraCalibration, kTracks, kSceneUpdate,
 };
 inline constexpr std::array kAllSchemas = {Schema::kRawSerial, Schema::kCanFrame, Schema::kRawImage,
                                            Schema::kCompressedImage, Schema::kLaserScan, Schema::kTiltSample,
                                            Schema::kPointCloud, Schema::kImageAnnotations, Schema::kFrameTransform,
-                                           Schema::kCameraCalibration};
+                                           Schema::kCameraCalibration, Schema::kTracks, Schema::kSceneUpdate};
 std::string_view schemaName(Schema s);  // "fusedet.RawSerial", "foxglove.RawImage", ...
 std::string_view schemaJson(Schema s);  // its JSON Schema text
 std::optional<Schema> schemaByName(std::string_view name);
@@ -114,7 +118,34 @@ struct CameraCalibrationMessage {
   std::array<double, 12> P{};                        // projection matrix, row-major
 };
 
-// Encoders: the JSON message bytes of each channel.
+// A stamp as the messages' "timestamp" carries it: whole seconds and nanoseconds in [0, 1e9).
+struct SecNsec {
+  std::int64_t sec = 0, nsec = 0;
+};
+SecNsec secNsec(Stamp s);
+
+// Objects in 3D for a viewer (foxglove.SceneUpdate): one entity per object, drawn as a sphere with
+// a text above it and, when it moves, an arrow along its velocity. Every message first deletes
+// every entity the channel drew before (SceneEntityDeletion ALL), so an object absent from a
+// message disappears; each entity also expires after `lifetimeS` (no further message needed).
+struct SceneObject {
+  std::string id;                               // entity id, unique within a message
+  std::string text;                             // drawn above it
+  std::array<double, 3> position{};             // [m] in the message's frame
+  std::array<double, 3> velocity{};             // [m/s]; the arrow is 1 s of travel long
+  double diameter = 0.5;                        // of the sphere [m]
+  std::array<double, 4> colour{1, 1, 1, 1};     // r g b a in [0, 1]
+  std::vector<std::pair<std::string, std::string>> metadata;  // key/value pairs a viewer lists
+};
+struct SceneUpdateMessage {
+  Stamp stamp;
+  std::string frame = "laser_base";
+  double lifetimeS = 0;  // 0 = until deleted
+  std::vector<SceneObject> objects;
+};
+
+// Encoders: the JSON message bytes of each channel (fusedet.Tracks is the daemon's tracks line,
+// fusedet/sensor_logs/track_channels.h).
 std::vector<std::uint8_t> encode(const SerialChunk& m);
 std::vector<std::uint8_t> encode(const CanMessage& m);
 std::vector<std::uint8_t> encode(const CameraFrame& m);  // RawImage, or CompressedImage for MJPEG
@@ -124,6 +155,7 @@ std::vector<std::uint8_t> encode(const PointCloudMessage& m);
 std::vector<std::uint8_t> encode(const AnnotationsMessage& m);
 std::vector<std::uint8_t> encode(const TransformMessage& m);
 std::vector<std::uint8_t> encode(const CameraCalibrationMessage& m);
+std::vector<std::uint8_t> encode(const SceneUpdateMessage& m);
 Schema schemaOf(const CameraFrame& m);
 
 // Decoders: errors (std::errc::bad_message) name the field that is missing or malformed.

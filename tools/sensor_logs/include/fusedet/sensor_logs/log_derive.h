@@ -11,6 +11,10 @@
 //   /camera/calibration  foxglove.CameraCalibration  with every camera frame
 //   /sweep/points        foxglove.PointCloud         every assembled sweep, frame `laser_base`
 //   /detections          foxglove.ImageAnnotations   per fused stack, stamped like its camera frame
+//   /tracks              fusedet.Tracks              per stack: the socket's tracks line (track_channels.h)
+//   /tracks/scene        foxglove.SceneUpdate        per stack: one 3D entity per live track
+// The stacks (detections, 3D positions, tracks) are the daemon's pipeline run on IN
+// (fusedet/daemon/offline_replay.h) with the rig's config and the given models: what fusedetd would send.
 // Derived channels IN already had are not copied (they are computed again).
 
 #include <cstdint>
@@ -29,7 +33,9 @@ struct DeriveReport {
   std::uint64_t dropped = 0;        // derived messages of IN not copied
   std::uint64_t scans = 0, tiltSamples = 0, frames = 0;
   std::uint64_t sweeps = 0, points = 0;
-  std::uint64_t stacks = 0, detections = 0;
+  std::uint64_t stacks = 0;          // sweeps paired with a camera frame; with models: stacks detected
+  std::uint64_t detections = 0;
+  std::uint64_t trackMessages = 0;   // on /tracks and /tracks/scene
   std::uint64_t transforms = 0;
   std::vector<std::string> classes;  // of the models
   bool calibrated = false;           // IN had a camera calibration (else no stacks, no detections)
