@@ -55,7 +55,12 @@ Result<CandumpEntry> parseCandumpLine(std::string_view s) {
       scale /= 10;
     }
   }
-  e.frame.stamp = Stamp{sec * 1'000'000'000 + frac * scale};
+  // Twelve digits of seconds fit an int64 but their nanoseconds may not (the limit is
+  // 9223372036.854775807 s, year 2262): refuse rather than overflow.
+  std::int64_t ns = 0;
+  if (__builtin_mul_overflow(sec, std::int64_t{1'000'000'000}, &ns) || __builtin_add_overflow(ns, frac * scale, &ns))
+    return bad("time stamp beyond 9223372036.854775807 s (64-bit nanoseconds)");
+  e.frame.stamp = Stamp{ns};
   s.remove_prefix(close + 1);
   // " interface "
   if (s.empty() || s.front() != ' ') return bad("expected a space after the time stamp");

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include "fusedet/drivers/canopen/candump_log.h"
@@ -62,6 +63,22 @@ TEST(Candump, BadLinesSayWhatIsWrong) {
   EXPECT_EQ(why("(1.0) can0 123#GG"), "data is not hex");
   EXPECT_EQ(why("(1.0) can0 123#R9"), "remote request length must be one digit 0..8");
   EXPECT_EQ(why("(1.0) can0"), "expected an interface name and a space");
+}
+
+// UBSan found it (issue 37): a seconds value whose nanoseconds exceed int64 overflowed; the
+// reader accepted the line with a wrapped, meaningless stamp. The largest stamp still reads.
+TEST(Candump, StampsBeyondSixtyFourBitNanosecondsAreRefused) {
+  auto why = [](const char* line) {
+    auto r = parseCandumpLine(line);
+    return r ? std::string("accepted") : r.error().context;
+  };
+  const std::string tooLate = "time stamp beyond 9223372036.854775807 s (64-bit nanoseconds)";
+  EXPECT_EQ(why("(17000000800.000000) can0 123#00"), tooLate);  // the fuzzed line that overflowed
+  EXPECT_EQ(why("(999999999999.999999999) can0 123#00"), tooLate);
+  EXPECT_EQ(why("(9223372036.854775808) can0 123#00"), tooLate);
+  auto last = parseCandumpLine("(9223372036.854775807) can0 123#00");
+  ASSERT_TRUE(last) << last.error().message();
+  EXPECT_EQ(last->frame.stamp.ns, std::numeric_limits<std::int64_t>::max());
 }
 
 TEST(Candump, WriteReadRoundTrip) {
