@@ -2,7 +2,9 @@
 // The MCAP reader's memory on a corrupt log (issue 37): a chunk header may claim any
 // uncompressed size up to the reader's 1 GiB plausibility limit. The reader used to allocate
 // the claimed size before decompressing; a 2 kB file could cost 1 GiB. This binary replaces
-// the global operator new to record the largest single allocation while such a file is read.
+// the global operator new to record the largest single allocation while such a file is read:
+// every non-aligned form (plain, array, nothrow), so that each new and each delete are ours and
+// pair up (ASan reports a nothrow new it allocated but our delete freed as a mismatch).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -18,17 +20,31 @@
 
 namespace {
 std::atomic<std::size_t> largest{0};
-}  // namespace
 
-void* operator new(std::size_t n) {
+void* recordedAlloc(std::size_t n) noexcept {
   std::size_t seen = largest.load();
   while (n > seen && !largest.compare_exchange_weak(seen, n)) {
   }
-  if (void* p = std::malloc(n ? n : 1)) return p;
+  return std::malloc(n ? n : 1);
+}
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (void* p = recordedAlloc(n)) return p;
   throw std::bad_alloc();
 }
+void* operator new[](std::size_t n) {
+  if (void* p = recordedAlloc(n)) return p;
+  throw std::bad_alloc();
+}
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return recordedAlloc(n); }
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return recordedAlloc(n); }
 void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace fs = std::filesystem;
 using namespace fusedet::drivers::mcap;
