@@ -22,8 +22,10 @@ std::optional<TiltTpdo> TiltTpdoDecoder::decode(const CanFrame& f) {
   t.statusword = static_cast<std::uint16_t>(readLe(f.data, 4, 2));
   t.sample.stamp = f.stamp;
   t.sample.angle = units_.toRad(static_cast<std::int32_t>(readLe(f.data, 0, 4)));
-  if (last_ && f.stamp > last_->stamp && f.stamp - last_->stamp < kVelocityGapNs)
-    t.sample.velocity = (t.sample.angle - last_->angle) / (static_cast<double>(f.stamp - last_->stamp) * 1e-9);
+  // Stamps from a log may lie anywhere in int64: a difference that does not fit is no recent sample.
+  std::int64_t dt = 0;
+  if (last_ && f.stamp > last_->stamp && !__builtin_sub_overflow(f.stamp.ns, last_->stamp.ns, &dt) && dt < kVelocityGapNs)
+    t.sample.velocity = (t.sample.angle - last_->angle) / (static_cast<double>(dt) * 1e-9);
   last_ = t.sample;
   ++samples_;
   return t;

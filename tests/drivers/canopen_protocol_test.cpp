@@ -8,6 +8,7 @@
 #include "fusedet/drivers/canopen/inprocess_bus.h"
 #include "fusedet/drivers/canopen/protocol.h"
 #include "fusedet/drivers/canopen/sdo_client.h"
+#include "fusedet/drivers/canopen/tilt_tpdo.h"
 
 using namespace fusedet::drivers::canopen;
 using namespace std::chrono_literals;
@@ -167,4 +168,28 @@ TEST(SdoClient, TimeoutSendsAbortAndStartsTheNext) {
   x.answer({0x4B, 0x64, 0x60, 0x00, 1, 0, 0, 0});    // wrong size for 0x6064 but well-formed
   EXPECT_EQ(results.size(), 2u);
   EXPECT_EQ(x.sdo.counters().timeouts, 1u);
+}
+
+// Found by fuzzing (issue 37, tests/fuzz/can_frames.cpp): two TPDO1 stamps whose difference does
+// not fit int64 (a log may carry any stamp) overflowed the velocity's time step (undefined
+// behaviour; in practice a wrapped, negative step and a velocity with the wrong sign). A step
+// that does not fit is no recent sample: velocity 0; the rule still works on the next ones.
+TEST(TiltTpdo, StampsWhoseDifferenceOverflowsGiveNoVelocity) {
+  const TiltUnits units{1000, 2.0, 0};
+  TiltTpdoDecoder decoder(5, units);
+  auto tpdo = [](std::int64_t stamp, std::int32_t counts) {
+    CanFrame f = CanFrame::make(0x185, {0, 0, 0, 0, 0x37, 0x06});
+    writeLe(f.data, 0, static_cast<std::uint32_t>(counts), 4);
+    f.stamp = fusedet::Stamp{stamp};
+    return f;
+  };
+  ASSERT_TRUE(decoder.isTpdo(tpdo(0, 0)));
+  ASSERT_TRUE(decoder.decode(tpdo(-8825501086245354107, 0)));
+  const auto far = decoder.decode(tpdo(3388976314039305862, 1000));
+  ASSERT_TRUE(far);
+  EXPECT_EQ(far->sample.velocity, 0.0);
+  EXPECT_EQ(far->statusword, 0x0637);
+  const auto next = decoder.decode(tpdo(3388976314039305862 + 100'000'000, 1100));
+  ASSERT_TRUE(next);
+  EXPECT_NEAR(next->sample.velocity, (units.toRad(1100) - units.toRad(1000)) / 0.1, 1e-9);
 }
