@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <map>
@@ -392,7 +393,11 @@ Result<CameraFrame> V4l2Camera::readFrame(std::chrono::milliseconds timeout) {
     }
     const SequenceTracker::Step step = sequence_.next(b.sequence);
     Stamp stamp;
-    if ((b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) {
+    // A monotonic stamp is boot time: seconds beyond what int64 nanoseconds hold (292 years) or
+    // microseconds outside a second are a broken driver's, not a time (they overflowed here).
+    const bool usable = b.timestamp.tv_sec >= 0 && b.timestamp.tv_sec < INT64_MAX / 1'000'000'000 &&
+                        b.timestamp.tv_usec >= 0 && b.timestamp.tv_usec < 1'000'000;
+    if ((b.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC && usable) {
       stamp = Stamp{static_cast<std::int64_t>(b.timestamp.tv_sec) * 1'000'000'000 +
                     static_cast<std::int64_t>(b.timestamp.tv_usec) * 1000};
     } else {

@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <atomic>
 #include <map>
+#include <optional>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -38,6 +39,7 @@ struct FakeFrame {
   std::int64_t bytesUsed = -1;           // -1: the whole image
   std::int64_t stampNs = 1'000'000'000;  // buffer timestamp
   std::int64_t forceIndex = -1;          // >= 0: report this buffer index (a misbehaving driver)
+  std::optional<timeval> rawStamp = std::nullopt;  // reported as is instead of stampNs (a misbehaving driver)
 };
 
 class FakeV4l2Device final : public drivers::v4l2::V4l2Io {
@@ -301,6 +303,7 @@ class FakeV4l2Device final : public drivers::v4l2::V4l2Io {
     b.field = V4L2_FIELD_NONE;
     b.timestamp.tv_sec = f.stampNs / 1'000'000'000;
     b.timestamp.tv_usec = (f.stampNs % 1'000'000'000) / 1000;
+    if (f.rawStamp) b.timestamp = *f.rawStamp;
     return 0;
   }
 

@@ -128,6 +128,31 @@ TEST(V4l2Camera, NonMonotonicStampsAreReplacedAndCounted) {
   EXPECT_EQ(cam.counters().hostStamps, 1u);
 }
 
+// Found by fuzzing (issue 37, tests/fuzz/v4l2_answers.cpp): a driver's "monotonic" stamp of
+// 271579372060572 s overflowed the conversion to nanoseconds (undefined behaviour; in practice a
+// wrapped, negative stamp). Seconds or microseconds out of range are the dequeue time now, counted.
+TEST(V4l2Camera, MonotonicStampsOutOfRangeAreReplacedAndCounted) {
+  Rig rig;
+  auto& cam = rig.make();
+  ASSERT_TRUE(cam.start());
+  FakeFrame huge{0}, negative{1}, badMicros{2}, fine{3, 0, -1, 7'000'000'000};
+  huge.rawStamp = timeval{271579372060572, 0};
+  negative.rawStamp = timeval{-5, 0};
+  badMicros.rawStamp = timeval{5, 1'000'000};
+  rig.fake->script = {huge, negative, badMicros, fine};
+  const fusedet::Stamp before = fusedet::Stamp::now();
+  for (int i = 0; i < 3; ++i) {
+    auto f = cam.readFrame(100ms);
+    ASSERT_TRUE(f);
+    EXPECT_GE(f->stamp, before) << i;
+    EXPECT_LE(f->stamp, fusedet::Stamp::now()) << i;
+  }
+  auto f = cam.readFrame(100ms);
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->stamp.ns, 7'000'000'000);
+  EXPECT_EQ(cam.counters().hostStamps, 3u);
+}
+
 TEST(V4l2Camera, ErrorAndShortBuffersAreSkippedCountedAndRecorded) {
   Rig rig;
   auto& cam = rig.make();

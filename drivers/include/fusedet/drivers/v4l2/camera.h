@@ -72,7 +72,7 @@ struct CameraCounters {
   std::uint64_t sequenceResets = 0;  // the driver's counter went back without a stream restart
   std::uint64_t errorFrames = 0;     // buffers flagged V4L2_BUF_FLAG_ERROR (not delivered)
   std::uint64_t shortFrames = 0;     // empty, or less than one image of raw pixels (not delivered)
-  std::uint64_t hostStamps = 0;      // frames stamped at dequeue: the driver's stamp is not monotonic
+  std::uint64_t hostStamps = 0;      // frames stamped at dequeue: the driver's stamp is not monotonic (or out of range)
   std::uint64_t stampsBackwards = 0; // frames not stamped after the frame before them
   std::uint64_t timeouts = 0;        // poll timeouts
   std::uint64_t bufferErrors = 0;    // dequeue answers inconsistent with the bookkeeping
