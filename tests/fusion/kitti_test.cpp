@@ -69,3 +69,23 @@ TEST(Kitti, BadFilesNameTheFileAndProblem) {
   EXPECT_THROW((void)readKittiLabels(labels), std::runtime_error);
   EXPECT_THROW((void)readKittiFrame(kKitti, "999999"), std::runtime_error);
 }
+
+// Found writing the fuzz corpus (issue 37, tests/fuzz/corpus/kitti_text/calib_tiny_focal.txt): a
+// P2 with a focal length of 1e-300 passes the K [I | t] form check, and K^-1 P2(:, 3) overflows
+// to inf: every projected point would have been inf or NaN. It is refused now; a sane K is not.
+TEST(Kitti, ACalibWhoseTransformIsNotFiniteIsRefused) {
+  KittiCalib calib;
+  calib.P2 << 1e-300, 0, 0, 1e300, 0, 1e-300, 0, 0, 0, 0, 1, 0;
+  calib.R0rect.setIdentity();
+  calib.TrVeloToCam << 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0;
+  try {
+    (void)kittiProjection(calib, 1242, 375);
+    FAIL() << "accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("non-finite transform"), std::string::npos) << e.what();
+  }
+  calib.P2 << 700, 0, 600, 45, 0, 700, 180, 0, 0, 0, 1, 0;
+  const auto p = kittiProjection(calib, 1242, 375);
+  EXPECT_TRUE(p.sweepToCamera.matrix().allFinite());
+  EXPECT_NEAR(p.sweepToCamera.translation().x(), 45.0 / 700, 1e-12);
+}

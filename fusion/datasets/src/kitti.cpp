@@ -58,6 +58,10 @@ PinholeProjection kittiProjection(const KittiCalib& calib, int width, int height
   Eigen::Isometry3d velo = Eigen::Isometry3d::Identity();
   velo.matrix().topRows<3>() = calib.TrVeloToCam;
   p.sweepToCamera = shift * rect * velo;
+  // A focal length near 0 (or huge entries) passes the form check but K^-1 P2(:, 3) overflows:
+  // every projected point would be inf / NaN.
+  if (!p.sweepToCamera.matrix().allFinite())
+    throw std::runtime_error("KITTI calib: P2, R0_rect and Tr_velo_to_cam give a non-finite transform (K nearly singular?)");
   p.width = width;
   p.height = height;
   return p;
