@@ -28,14 +28,34 @@ SweepAssembler::SweepAssembler(SweepConfig config)
 
 void SweepAssembler::addTilt(const drivers::TiltSample& sample) {
   ++stats_.tiltSamples;
-  if (!tilt_.empty() && sample.stamp <= tilt_.back().stamp) {
-    ++stats_.tiltOutOfOrder;
-    return;
-  }
   if (!std::isfinite(sample.angle)) {
     ++stats_.tiltOutOfOrder;
     return;
   }
+  if (!tilt_.empty() && sample.stamp <= tilt_.back().stamp) {
+    ++stats_.tiltOutOfOrder;
+    // Far behind the newest sample: the newest may be the one off (a clock step). Enough samples
+    // in order among themselves decide it: the history is dropped and they continue it.
+    const bool farBehind = tilt_.back().stamp - sample.stamp > maxSweepNs_;
+    const bool continuesRun = behind_.empty() || sample.stamp > behind_.back().stamp;
+    if (!farBehind) {
+      behind_.clear();
+      return;
+    }
+    if (!continuesRun) behind_.clear();
+    behind_.push_back(sample);
+    if (behind_.size() < static_cast<std::size_t>(kClockStepConfirm)) return;
+    ++stats_.tiltClockSteps;
+    stats_.tiltOutOfOrder -= behind_.size();
+    tilt_.assign(behind_.begin(), behind_.end());
+    behind_.clear();
+    stillFrom_ = tilt_.front();
+    for (const drivers::TiltSample& s : tilt_)
+      if (std::abs(s.angle - stillFrom_->angle) >= config_.minTiltChange) stillFrom_ = s;
+    process(false);
+    return;
+  }
+  behind_.clear();
   tilt_.push_back(sample);
   if (!stillFrom_ || std::abs(sample.angle - stillFrom_->angle) >= config_.minTiltChange) stillFrom_ = sample;
   process(false);

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <optional>
 
 using namespace fusedet;
 using namespace fusedet::fusion;
@@ -486,4 +488,80 @@ TEST(SweepAssemblerBounds, ASilentLaserDoesNotGrowTheTiltHistory) {
   EXPECT_FALSE(a.tiltAt(Stamp{kT0 + 1'000'000'000}, angle));           // long forgotten
   EXPECT_TRUE(a.tiltAt(Stamp{kT0 + 600'000'000'000 - 500'000'000}, angle));  // recent: kept
   EXPECT_EQ(a.stats().tiltSamples, 60'000u);
+}
+
+namespace {
+// Four seconds of nodding (a reversal every second), tilt at 100 Hz and scans at 75 Hz in time
+// order; `extra` adds one more tilt sample when the stream reaches its arrival time.
+struct ClockRun {
+  std::vector<Sweep> sweeps;
+  SweepStats stats;
+};
+ClockRun nodWithExtraSample(std::optional<std::pair<std::int64_t, TiltSample>> extra) {
+  const auto nod = [](std::int64_t ns) { return triangle(kT0 + (ns - kT0) % 2'000'000'000); };
+  SweepAssembler a(wallConfig());
+  ClockRun out;
+  std::int64_t nextTilt = kT0 - 20'000'000, nextScan = kT0;
+  const std::int64_t end = kT0 + 4'000'000'000;
+  std::uint64_t seq = 0;
+  while (nextScan < end) {
+    if (extra && extra->first <= std::min(nextTilt, nextScan)) {
+      a.addTilt(extra->second);
+      extra.reset();
+    } else if (nextTilt <= nextScan) {
+      a.addTilt(TiltSample{Stamp{nextTilt}, nod(nextTilt), 0});
+      nextTilt += 10'000'000;
+    } else {
+      a.addScan(wallScan(nextScan, nod, seq++));
+      nextScan += kScanNs;
+    }
+    for (Sweep& s : a.takeSweeps()) out.sweeps.push_back(std::move(s));
+  }
+  a.flush();
+  for (Sweep& s : a.takeSweeps()) out.sweeps.push_back(std::move(s));
+  out.stats = a.stats();
+  return out;
+}
+}  // namespace
+
+// Issue 37, clock jumps: SocketCAN's CLOCK_REALTIME stamps moved to the monotonic clock put the
+// frames received around a wall-clock step off by the step. One tilt sample stamped an hour
+// ahead made every later sample "out of order": no sweep for the rest of the run (an hour). Now
+// three samples in order among themselves restart the history: 30 ms of tilt lost at 100 Hz.
+TEST(SweepAssemblerClock, ATiltSampleStampedAnHourAheadCostsThreeSamplesNotAnHour) {
+  const ClockRun clean = nodWithExtraSample(std::nullopt);
+  ASSERT_EQ(clean.sweeps.size(), 4u);
+  const std::int64_t at = kT0 + 1'500'000'000;  // mid-sweep, rising... falling after the 1 s peak
+  const ClockRun stepped = nodWithExtraSample(std::make_pair(at, TiltSample{Stamp{at + 3'600'000'000'000}, 0.1, 0}));
+  EXPECT_EQ(stepped.stats.tiltClockSteps, 1u);
+  // The sweep the step fell into loses the scans of those three samples (or is cut short); the
+  // ones after it are exactly those of the clean run.
+  ASSERT_GE(stepped.sweeps.size(), 3u);
+  const std::uint64_t lostScans = stepped.stats.scansDroppedNoTilt - clean.stats.scansDroppedNoTilt;
+  EXPECT_GE(lostScans, 1u);
+  EXPECT_LE(lostScans, 4u) << "three 10 ms samples span at most four 13.3 ms scans";
+  for (std::size_t k = 1; k <= 2; ++k) {
+    const Sweep& x = clean.sweeps[clean.sweeps.size() - k];
+    const Sweep& y = stepped.sweeps[stepped.sweeps.size() - k];
+    EXPECT_EQ(x.start, y.start);
+    EXPECT_EQ(x.end, y.end);
+    EXPECT_EQ(x.points.size(), y.points.size());
+  }
+  std::printf("clock step +1 h: %ju scans without tilt (%.1f ms of 75 Hz scans), %zu sweeps (clean run %zu)\n",
+              static_cast<std::uintmax_t>(lostScans), static_cast<double>(lostScans) * kScanNs * 1e-6,
+              stepped.sweeps.size(), clean.sweeps.size());
+}
+
+// A sample stamped an hour behind (a step the other way) is ignored like any out-of-order one.
+TEST(SweepAssemblerClock, ATiltSampleStampedAnHourBehindIsIgnored) {
+  const ClockRun clean = nodWithExtraSample(std::nullopt);
+  const std::int64_t at = kT0 + 1'500'000'000;
+  const ClockRun stepped = nodWithExtraSample(std::make_pair(at, TiltSample{Stamp{at - 3'600'000'000'000}, 0.1, 0}));
+  EXPECT_EQ(stepped.stats.tiltClockSteps, 0u);
+  EXPECT_EQ(stepped.stats.tiltOutOfOrder, clean.stats.tiltOutOfOrder + 1);
+  ASSERT_EQ(stepped.sweeps.size(), clean.sweeps.size());
+  for (std::size_t k = 0; k < clean.sweeps.size(); ++k) {
+    EXPECT_EQ(stepped.sweeps[k].start, clean.sweeps[k].start);
+    EXPECT_EQ(stepped.sweeps[k].points.size(), clean.sweeps[k].points.size());
+  }
 }

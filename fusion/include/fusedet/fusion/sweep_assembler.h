@@ -35,6 +35,14 @@
 // Tilt samples older than `maxSweepS` before the newest one are forgotten even while the laser is
 // silent (scans that late are dropped as having no tilt). `tiltStillS` says for how long the laser
 // has scanned while the tilt stood still (the daemon's `status` shows it).
+//
+// Clock steps: SocketCAN stamps frames in CLOCK_REALTIME and the bus moves them to the monotonic
+// clock at reception, so the frames received around a wall-clock step (NTP, an RTC set) carry a
+// stamp off by the step. A tilt sample stamped far behind is ignored like any out-of-order one;
+// one stamped far ahead used to make every later sample "out of order" until the clock reached
+// it (an hour of no sweeps for a one-hour step). Now `kClockStepConfirm` consecutive samples in
+// order among themselves but more than `maxSweepS` behind the newest one mean the history is on
+// another time line: it is dropped and they start it afresh (counted in `tiltClockSteps`).
 
 #include <Eigen/Geometry>
 #include <cstdint>
@@ -68,6 +76,7 @@ struct SweepStats {
   std::uint64_t scansDroppedNoTilt = 0;  // no tilt samples within the window around some beam
   std::uint64_t tiltSamples = 0;
   std::uint64_t tiltOutOfOrder = 0;    // samples not newer than the last one, ignored
+  std::uint64_t tiltClockSteps = 0;    // tilt history dropped: the samples came back from a stamp far ahead
   std::uint64_t sweeps = 0;            // sweeps completed
   std::uint64_t sweepsClosedOnTilt = 0;  // of these, closed by tilt samples before the next scan (closeOnTilt)
   std::uint64_t points = 0;            // points in completed sweeps
@@ -77,6 +86,8 @@ struct SweepStats {
 
 class SweepAssembler {
  public:
+  static constexpr int kClockStepConfirm = 3;  // samples that agree with each other, not with the history
+
   explicit SweepAssembler(SweepConfig config = {});
 
   void addTilt(const drivers::TiltSample& sample);
@@ -109,6 +120,7 @@ class SweepAssembler {
   std::int64_t maxSweepNs_;
   std::optional<drivers::TiltSample> stillFrom_;  // the sample the tilt has not moved away from since
   std::deque<drivers::TiltSample> tilt_;
+  std::vector<drivers::TiltSample> behind_;  // consecutive samples far behind the history (a clock step?)
   std::deque<drivers::LaserScan> pending_;
   Stamp newestScan_{};             // last beam of the newest scan received
   std::optional<Stamp> newestStart_;  // first beam of the newest scan received
