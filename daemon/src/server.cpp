@@ -181,6 +181,7 @@ Server::Server(drivers::UniqueFd listener, ServerLimits limits, Handlers handler
   if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, listener_.get(), &ev) < 0) throwErrno("epoll_ctl listener");
   ev.data.u64 = kWakeKey;
   if (::epoll_ctl(epoll_.get(), EPOLL_CTL_ADD, wake_.get(), &ev) < 0) throwErrno("epoll_ctl eventfd");
+  spare_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
 }
 
 Server::~Server() { stop(std::chrono::steady_clock::now()); }
@@ -231,10 +232,17 @@ void Server::run() {
   };
   while (!stopping_) {
     beat_ = Stamp::now().ns;
-    const int n = ::epoll_wait(epoll_.get(), events, 64, 200);
+    const int n = ::epoll_wait(epoll_.get(), events, 64, listenerPausedUntil_ ? 20 : 200);
     if (n < 0 && errno != EINTR) {
       spdlog::error("server: epoll_wait: {}", std::strerror(errno));
       break;
+    }
+    if (listenerPausedUntil_ && std::chrono::steady_clock::now() >= *listenerPausedUntil_) {
+      epoll_event ev{};
+      ev.events = EPOLLIN;
+      ev.data.u64 = kListenerKey;
+      ::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, listener_.get(), &ev);
+      listenerPausedUntil_.reset();
     }
     for (int i = 0; i < n; ++i) {
       const std::uint64_t key = events[i].data.u64;
@@ -278,8 +286,14 @@ void Server::accept() {
   for (;;) {
     drivers::UniqueFd fd(::accept4(listener_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
     if (!fd.valid()) {
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR && errno != ECONNABORTED)
-        spdlog::warn("server: accept: {}", std::strerror(errno));
+      const int err = errno;
+      if (err == EMFILE || err == ENFILE) {
+        if (refuseWithoutDescriptor(err)) continue;
+        pauseListener();
+        return;
+      }
+      if (err != EAGAIN && err != EWOULDBLOCK && err != EINTR && err != ECONNABORTED)
+        spdlog::warn("server: accept: {}", std::strerror(err));
       return;
     }
     ServerLimits limits;
@@ -337,6 +351,34 @@ void Server::accept() {
     }
     updatePeers();
   }
+}
+
+bool Server::refuseWithoutDescriptor(int err) {
+  const auto now = std::chrono::steady_clock::now();
+  if (now - lastNoFdWarning_ >= std::chrono::seconds(1)) {  // once a second, not once a connection
+    spdlog::warn("server: out of file descriptors ({}): refusing new clients", std::strerror(err));
+    lastNoFdWarning_ = now;
+  }
+  if (!spare_.valid()) return false;
+  spare_.reset();
+  drivers::UniqueFd fd(::accept4(listener_.get(), nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC));
+  const bool taken = fd.valid();
+  if (taken) {
+    const std::string line = errorLine(std::string("server out of file descriptors (") + std::strerror(err) + "); try again later");
+    [[maybe_unused]] auto w = ::send(fd.get(), line.data(), line.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
+    fd.reset();
+    std::lock_guard lock(mutex_);
+    ++counters_.refusedNoFd;
+  }
+  spare_.reset(::open("/dev/null", O_RDONLY | O_CLOEXEC));
+  return taken && spare_.valid();
+}
+
+void Server::pauseListener() {
+  epoll_event ev{};
+  ev.data.u64 = kListenerKey;
+  ::epoll_ctl(epoll_.get(), EPOLL_CTL_MOD, listener_.get(), &ev);  // no events until resumed
+  listenerPausedUntil_ = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
 }
 
 void Server::updatePeers() {

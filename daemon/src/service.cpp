@@ -244,6 +244,7 @@ nlohmann::json Service::status() const {
         {"bad_requests", s.badRequests},
         {"oversized_requests", s.oversized},
         {"refused_not_allowed", s.refusedNotAllowed},
+        {"refused_no_fd", s.refusedNoFd},
         {"peers", peers}}},
       {"reloads", reloads_},
       {"last_reload_error", lastReloadError_}};

@@ -24,33 +24,15 @@
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/server.h"
+#include "server_fixtures.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
 using namespace std::chrono_literals;
+using fusedet::daemon::server_test::makeResult;
+using fusedet::daemon::server_test::tempSocket;
 
 namespace {
-
-std::string tempSocket(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("fusedet-test-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
-}
-
-std::shared_ptr<const StackResult> makeResult(std::uint64_t id) {
-  auto r = std::make_shared<StackResult>();
-  r->stackId = id;
-  r->sensorStamp = Stamp::now();
-  r->frameStamp = r->sensorStamp;
-  for (int i = 0; i < 10; ++i) {  // ~1.5 kB per line
-    LocatedDetection d;
-    d.detection.className = i % 2 ? "car" : "bike";
-    d.detection.score = i;
-    d.detection.box = {double(i), 2, 30, 40};
-    r->detections.push_back(d);
-  }
-  return r;
-}
 
 struct Received {
   std::vector<std::uint64_t> ids;

@@ -43,6 +43,7 @@ struct ServerCounters {
   std::uint64_t accepted = 0;
   std::uint64_t refused = 0;         // over max_clients
   std::uint64_t refusedNotAllowed = 0;  // in none of socket.allow_groups
+  std::uint64_t refusedNoFd = 0;     // the daemon was out of file descriptors (EMFILE, ENFILE)
   std::uint64_t droppedSlow = 0;     // queue overflow: slow or silent clients
   std::uint64_t disconnected = 0;    // closed by the client (or a socket error)
   std::uint64_t badRequests = 0;     // not JSON, unknown cmd, ...
@@ -91,6 +92,8 @@ class Server {
   struct Client;
   void run();
   void accept();
+  bool refuseWithoutDescriptor(int err);
+  void pauseListener();
   void readFrom(Client& c);
   void handleLine(Client& c, std::string_view line);
   void queue(Client& c, std::shared_ptr<const std::string> line);
@@ -101,6 +104,12 @@ class Server {
   void updatePeers();
 
   drivers::UniqueFd listener_, epoll_, wake_;
+  // Out of descriptors, a pending connection keeps the listener readable: epoll would return at
+  // once, forever (a spinning server). The spare (/dev/null) is given up for a moment to take the
+  // connection, tell the client why and close it; without it the listener pauses 100 ms.
+  drivers::UniqueFd spare_;
+  std::optional<std::chrono::steady_clock::time_point> listenerPausedUntil_;  // server thread only
+  std::chrono::steady_clock::time_point lastNoFdWarning_;                     // server thread only
   Handlers handlers_;
   std::thread thread_;
   std::atomic<bool> stopping_{false};
