@@ -18,7 +18,10 @@
 #include "fusedet/boost/float_cut.h"
 #include "opencv_pyramid.h"
 
-#if defined(__x86_64__) && defined(__GNUC__)
+// GCC only: the vector copies get their instruction sets from `#pragma GCC target`, which clang
+// (the fuzz build, tests/fuzz) does not apply, so it refuses the intrinsics; clang takes the
+// scalar path, which the vector lanes equal bit for bit.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define FUSEDET_HAVE_AVX2_GRID_PATH 1
 #endif
