@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the socket server tests feed the server: a socket path in a folder of this test process,
 // and synthetic stack results (no detection cost, so the tests are about the server).

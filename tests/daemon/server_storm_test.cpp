@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The socket server under floods (issue 37's fault matrix): a thousand clients connecting at
 // once, the daemon out of file descriptors while clients keep connecting, and a request line of
 // 1 GiB. Results are synthetic (no detection cost): the test is about the server. Each prints

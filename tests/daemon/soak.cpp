@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // daemon_soak: fusedetd replaying a sensor log in a loop (replay.at_end: loop, paced like the
 // recording, the bundled models) while 50 clients connect, subscribe, ask and leave, for a given
 // time (issue 37's soak). Every 10 s it samples the daemon's resident memory and open descriptors

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ByteSource: a fuzz input consumed front to back as the numbers a target needs (a device's
 // answers, frame fields, choices). Past the end every read yields zeros and exhausted() is true,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: CAN frames from the tilt motor's node as the master takes them - into the
 // SDO client (expedited and segmented uploads, downloads, aborts, toggles, late answers) and the
 // TPDO1 decoder - and each frame described as `fusedet tilt monitor` prints it. The input is a

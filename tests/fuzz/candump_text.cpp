@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: candump -l text (can-utils' log format, the tilt motor's recordings) as
 // readCandumpLog reads a file and parseCandumpLine takes each line. Bad lines may only be
 // refused with a message; an accepted line is a valid frame whose formatted line reads back to

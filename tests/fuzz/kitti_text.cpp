@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: KITTI text files - a frame's calib (P2, R0_rect, Tr_velo_to_cam), its
 // label_2 object labels and a drive's tracking labels - as the importers read them. The input is
 // offered to each reader (a calib file is not a label file, so most inputs are refused by some);
@@ -11,8 +12,8 @@
 #include <stdexcept>
 #include <string>
 
-#include "fusedet/fusion/kitti.h"
-#include "fusedet/fusion/kitti_tracks.h"
+#include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/datasets/kitti_tracks.h"
 #include "memory_file.h"
 
 namespace {

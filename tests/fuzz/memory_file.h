@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // MemoryFile: a fuzz input as a file with a path (an anonymous memfd, /proc/self/fd/N), for the
 // parsers that read a file by name. Closed when destroyed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // libFuzzer target: a camera's answers to V4L2 as V4l2Camera parses them - VIDIOC_QUERYCAP,
 // the format / frame-size / frame-interval enumerations (negotiation.h chooses among them),
 // S_FMT, G_PARM / S_PARM, control queries, REQBUFS / QUERYBUF, poll and DQBUF - from a device

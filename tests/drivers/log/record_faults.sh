@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # `fusedet record` (against lms291-sim on a pty) under two faults, issue 37's fault matrix:
 #  - disk full: the file may not grow past 48 KiB (~7 s of LMS data; RLIMIT_FSIZE: the kernel refuses the write past
 #    it with EFBIG through the same write path a full disk refuses with ENOSPC; SIGXFSZ ignored as
