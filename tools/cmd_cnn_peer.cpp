@@ -33,7 +33,17 @@ struct CnnPeerOptions {
   std::size_t resamples = 1000;
   std::uint64_t seed = 1;
   int threads = 1;
+  fs::path outcomes;
+  std::string config;
 };
+
+std::string commandLine(const CnnPeerOptions& o) {
+  std::string c = "fusedet cnn-peer --kind " + o.kind;
+  for (const fs::path& f : o.files) c += " --model " + f.string();
+  c += " --input " + o.input + " --data " + o.data.string() + " --min-iou " + experiments::shortNum(o.minIou) +
+       " --min-score " + experiments::shortNum(o.rule.minScore);
+  return c;
+}
 
 int runCnnPeer(const CnnPeerOptions& o) {
   const fusion::NetworkSpec spec{fusion::parseNetworkKind(o.kind), o.files, fusion::parseInputSize(o.input), o.threads};
@@ -69,6 +79,13 @@ int runCnnPeer(const CnnPeerOptions& o) {
                 experiments::formatEstimate(m.f).c_str(), experiments::formatEstimate(m.ap).c_str(), n.hits,
                 n.falseAlarms, n.misses);
   }
+  if (!o.outcomes.empty()) {
+    const std::string config = o.config.empty() ? o.files.front().stem().string() : o.config;
+    boosting::writeOutcomes(o.outcomes, boosting::cnnPeerOutcomes(run, frames, config, commandLine(o)));
+    std::printf("\noutcomes  %s (protocol untrained, configuration %s; pair with `fusedet compare RUN %s --protocol "
+                "lodo --protocol-b untrained --config all --config-b %s`)\n",
+                o.outcomes.c_str(), config.c_str(), o.outcomes.c_str(), config.c_str());
+  }
   return 0;
 }
 
@@ -98,6 +115,9 @@ const bool registered = registerCommand(
           ->capture_default_str();
       app.add_option("--resamples", o->resamples, "bootstrap resamples")->capture_default_str();
       app.add_option("--seed", o->seed, "bootstrap seed")->capture_default_str();
+      app.add_option("--outcomes", o->outcomes,
+                     "also write the per-frame outcomes to this file (docs/outcomes-format.md) for `fusedet compare`");
+      app.add_option("--config-name", o->config, "configuration name in --outcomes (default: the first model file's stem)");
       app.add_option("--threads", o->threads, "OpenCV threads while the network runs (1: the same output every run)")
           ->check(CLI::Range(1, 64))
           ->capture_default_str();

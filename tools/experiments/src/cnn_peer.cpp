@@ -18,6 +18,7 @@ CnnPeerRun runCnnPeer(fusion::Network& network, const std::vector<PeerFrame>& fr
   run.network = network.identity();
   std::map<std::string, MatchConfig> match;
   for (const std::string& c : classes) match[c] = matchFor(c);
+  run.rules = match;
   double ms = 0, cpuMs = 0;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const cv::Mat bgr = cv::imread(frames[i].image.string(), cv::IMREAD_COLOR);
@@ -39,6 +40,23 @@ CnnPeerRun runCnnPeer(fusion::Network& network, const std::vector<PeerFrame>& fr
   run.msPerFrame = ms / n;
   run.cpuMsPerFrame = cpuMs / n;
   return run;
+}
+
+RunOutcomes cnnPeerOutcomes(const CnnPeerRun& run, const std::vector<PeerFrame>& frames, const std::string& config,
+                            const std::string& command) {
+  RunOutcomes out;
+  out.command = command;
+  for (const auto& [cls, outcomes] : run.frames) {
+    OutcomeSet set;
+    set.className = cls;
+    set.protocol = "untrained";
+    set.config = config;
+    set.rule = run.rules.at(cls);
+    for (const PeerFrame& f : frames) set.frameIds.push_back(f.id);
+    set.frames = outcomes;
+    out.sets.push_back(std::move(set));
+  }
+  return out;
 }
 
 }  // namespace fusedet::boosting

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fusedet/boost/evaluation.h"
+#include "fusedet/boost/outcomes_file.h"
 #include "fusedet/boost/precision_recall.h"
 #include "fusedet/core/label.h"
 #include "fusedet/fusion/neural/coco_detections.h"
@@ -29,6 +30,7 @@ struct CnnPeerRun {
   fusion::NetworkIdentity network;
   std::map<std::string, std::vector<FrameOutcome>> frames;  // class -> per frame, in input order
   std::map<std::string, Counts> counts;                     // class -> counts at the operating point
+  std::map<std::string, MatchConfig> rules;                 // class -> how its detections were matched
   double msPerFrame = 0;     // mean wall time of the network run and decoding (image reading excluded)
   double cpuMsPerFrame = 0;  // the same in CPU time of the process (wall time also counts waiting for a core)
 };
@@ -41,5 +43,11 @@ CnnPeerRun runCnnPeer(fusion::Network& network, const std::vector<PeerFrame>& fr
                       const std::function<MatchConfig(const std::string&)>& matchFor,
                       const fusion::CocoDetectionRule& rule = {},
                       const std::function<void(std::size_t)>& progress = {});
+
+// The run as outcome sets (outcomes_file.h), one per class: protocol "untrained" (the network never
+// saw a frame: every frame is held out), configuration `config`, the frames' ids, so that
+// `fusedet compare` pairs it frame by frame with a cascade run on the same frames and rules.
+RunOutcomes cnnPeerOutcomes(const CnnPeerRun& run, const std::vector<PeerFrame>& frames, const std::string& config,
+                            const std::string& command);
 
 }  // namespace fusedet::boosting
