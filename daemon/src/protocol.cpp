@@ -12,7 +12,7 @@ std::optional<Request> parseRequest(std::string_view line, std::string& error, n
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(line.begin(), line.end());
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // parse_error, and out_of_range for a number like 1e999
     error = std::string("not JSON: ") + e.what();
     return std::nullopt;
   }

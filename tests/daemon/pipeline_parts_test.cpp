@@ -93,6 +93,13 @@ TEST(Protocol, ParsesTheDocumentedRequests) {
   EXPECT_EQ(err, "expected a JSON object");
   EXPECT_FALSE(parseRequest("{\"cmd\":", err));
   EXPECT_EQ(err.rfind("not JSON", 0), 0u);
+  // Found by fuzz_request (issue 37): a number beyond double (json out_of_range 406, not a
+  // parse_error) escaped parseRequest, and in fusedetd the server thread: std::terminate, the
+  // daemon gone for any local client that sent it. Now it is an error line like any bad JSON.
+  EXPECT_FALSE(parseRequest(R"({"cid":{"a":[1e20305,.,null]]}})", err));
+  EXPECT_FALSE(parseRequest(R"({"cmd":"status","x":1e999})", err));
+  EXPECT_EQ(err.rfind("not JSON", 0), 0u) << err;
+  EXPECT_NE(err.find("number overflow"), std::string::npos) << err;
 }
 
 TEST(Protocol, GarbageNeverThrowsAndAlwaysSaysWhy) {

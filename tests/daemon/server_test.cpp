@@ -242,6 +242,17 @@ TEST(Server, ErrorLinesCarryTheRequestsId) {
   auto notObject = a.read(5s);
   ASSERT_TRUE(notObject);
   EXPECT_FALSE(notObject->contains("id")) << notObject->dump();
+  // A number beyond double (found by fuzz_request) used to throw out of the server thread and
+  // end the process; it is an error line and the connection goes on.
+  a.sendLine(R"({"cmd":"status","x":1e999})");
+  auto overflow = a.read(5s);
+  ASSERT_TRUE(overflow);
+  EXPECT_EQ((*overflow)["type"], "error");
+  EXPECT_NE((*overflow)["error"].get<std::string>().find("number overflow"), std::string::npos) << overflow->dump();
+  a.send({{"cmd", "hello"}});
+  auto hello = a.read(5s);
+  ASSERT_TRUE(hello);
+  EXPECT_EQ((*hello)["type"], "hello");
   server.stop(std::chrono::steady_clock::now() + 1s);
 }
 
