@@ -126,6 +126,7 @@ int main(int argc, char** argv) {
   const double warmup = std::min(300.0, seconds / 5);
   fs::create_directories(out);
   const std::string socket = (out / "soak.sock").string();
+  fs::remove(socket);  // a previous run's: its existence must not pass for the daemon's readiness
   const std::string models = std::string(FUSEDET_SOURCE_DIR) + "/models/";
   {
     std::ofstream c(out / "soak.yaml");
@@ -146,7 +147,23 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "soak: cannot start %s\n", daemonPath.c_str());
     return 1;
   }
-  for (int i = 0; i < 300 && !fs::exists(socket); ++i) std::this_thread::sleep_for(100ms);
+  // Ready when it accepts a connection (the log may be synthesised first: up to a minute).
+  bool ready = false;
+  for (int i = 0; i < 1200 && !ready; ++i) {
+    try {
+      Client probe(socket);
+      ready = true;
+    } catch (const std::exception&) {
+      std::this_thread::sleep_for(100ms);
+    }
+  }
+  if (!ready) {
+    std::fprintf(stderr, "soak: fusedetd did not accept a connection within 120 s (see %s)\n", (out / "fusedetd.log").c_str());
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, nullptr, 0);
+    return 1;
+  }
+  std::this_thread::sleep_for(300ms);  // the probe's connection closed on the daemon's side too
   Sample initial;  // before any client: the listener's sockets
   sample(pid, socket, initial);
   const auto t0 = Clock::now();
@@ -156,17 +173,23 @@ int main(int argc, char** argv) {
   // The reference subscriber: every stack the daemon published, in order.
   std::mutex refMutex;
   std::vector<std::uint64_t> reference;
+  std::atomic<bool> refFailed{false};
   std::thread ref([&] {
-    Client c(socket);
-    c.send({{"cmd", "subscribe"}});
-    while (!stop) {
-      auto m = c.read(1s);
-      if (m && (*m)["type"] == "detections") {
-        std::lock_guard lock(refMutex);
-        reference.push_back((*m)["stack"].get<std::uint64_t>());
+    try {
+      Client c(socket);
+      c.send({{"cmd", "subscribe"}});
+      while (!stop) {
+        auto m = c.read(1s);
+        if (m && (*m)["type"] == "detections") {
+          std::lock_guard lock(refMutex);
+          reference.push_back((*m)["stack"].get<std::uint64_t>());
+        }
+        if (!m && c.closed()) break;
       }
-      if (!m && c.closed()) return;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "soak: reference subscriber: %s\n", e.what());
     }
+    if (!stop) refFailed = true;  // it must stay to the end
   });
 
   // Churning clients; each subscribed session's stacks are checked against the reference later.
@@ -224,7 +247,7 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 50; ++i) {
     std::this_thread::sleep_for(100ms);
     sample(pid, socket, quiet);
-    if (quiet.clients == 1 && quiet.sockets - 1 == initial.sockets) break;
+    if (quiet.clients == 1 && quiet.sockets - quiet.clients == initial.sockets - initial.clients) break;
   }
   stop = true;
   ref.join();
@@ -271,7 +294,7 @@ int main(int argc, char** argv) {
     }
     otherFdSpread = hi - lo;
   }
-  const int listenerSockets = initial.sockets;
+  const int listenerSockets = initial.sockets - initial.clients;
   const bool socketsBack = quiet.clients == 1 && quiet.sockets - quiet.clients == listenerSockets;
 
   std::ofstream csv(out / "soak.csv");
@@ -300,7 +323,7 @@ int main(int argc, char** argv) {
   panel(img, {60, 410, 800, 160}, t, p99, "latency p99 [ms]", seconds);
   cv::imwrite((out / "soak.png").string(), img);
 
-  const bool ok = steady.size() >= 3 && growth < 0.05 && otherFdSpread == 0 && socketsBack && gaps == 0 &&
+  const bool ok = !refFailed && steady.size() >= 3 && growth < 0.05 && otherFdSpread == 0 && socketsBack && gaps == 0 &&
                   subscribed > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
   std::printf("soak: %s: %.0f s, %d clients: %ju connections, %zu subscribed sessions (%zu stacks, %zu gaps), %ju requests "
               "answered, %ju client errors; after %.0f s warm-up memory grew %.1f %% (last third of the samples against the first), descriptors other than sockets "
