@@ -148,7 +148,7 @@ std::string Service::reload() {
 }
 
 std::string Service::reload(const Config& next) {
-  // The reloadable keys of `next` (config.h reloadableConfigKeys()); what else changed needs a
+  // The reloadable keys of `next` (config_keys.h reloadableConfigKeys()); what else changed needs a
   // restart (devices, socket path, fusion geometry).
   Config applied;
   std::shared_ptr<const StackDetector> detector;

@@ -77,8 +77,9 @@ class Service {
   bool sourcesStopped() const { return sourcesStopped_.load(); }
 
   // Re-reads the config file and the models. Returns "" when applied; else why the old
-  // configuration is kept. The keys of config.h reloadableConfigKeys() (detection settings and
-  // models, socket limits, log level) take effect at once; the log says other changes need a restart.
+  // configuration is kept. The keys of config_keys.h reloadableConfigKeys() (detection settings and
+  // models, socket limits and allow_groups, log level) take effect at once; the log says other
+  // changes need a restart.
   std::string reload();
   std::string reload(const Config& next);
 
