@@ -249,6 +249,21 @@ DatasetItem readDatasetItemLabels(const fs::path& datasetDir, const std::string&
   return itemFromJson(file, j);
 }
 
+void writeDatasetItemLabels(const fs::path& datasetDir, const std::string& id, const Labels& labels) {
+  fs::path file;
+  json j = readItemJson(datasetDir, id, file);
+  itemFromJson(file, j);  // the rest of the item must be valid before it is rewritten
+  json out = json::array();
+  for (const Label& l : labels) {
+    if (!std::isfinite(l.box.x) || !std::isfinite(l.box.y) || !std::isfinite(l.box.w) || !std::isfinite(l.box.h))
+      fail(file, "label of class '" + l.className + "' has a box that is not finite");
+    out.push_back(labelToJson(l));
+  }
+  j["labels"] = std::move(out);
+  const std::string text = j.dump(1) + "\n";
+  writeBytesAtomic(file, text.data(), text.size());
+}
+
 DatasetItem readDatasetItem(const fs::path& datasetDir, const std::string& id,
                             const std::vector<std::string>& wanted) {
   fs::path file;

@@ -57,5 +57,8 @@ DatasetItem readDatasetItem(const std::filesystem::path& datasetDir, const std::
 // Labels (and group) only, without decoding any image; `stack` is left empty except its reference
 // size, stamp, id and source.
 DatasetItem readDatasetItemLabels(const std::filesystem::path& datasetDir, const std::string& id);
+// Replaces one item's labels and nothing else (no image is decoded or written). Throws DatasetError
+// naming the file when the item is missing or malformed, or a label box is not finite.
+void writeDatasetItemLabels(const std::filesystem::path& datasetDir, const std::string& id, const Labels& labels);
 
 }  // namespace fusedet
