@@ -82,7 +82,8 @@ const bool registered = registerCommand(
       app.footer(
           "Tiles: the colour image, then every layer (8-bit as grey, hue as colour, distance colour-\n"
           "mapped near=red far=blue, remission grey; invalid laser cells black). Labels green (van\n"
-          "orange), ignore regions grey dashed, detections red with class and score.\n\n"
+          "orange), ignore regions grey dashed, labels a teacher drew (fusedet autolabel) cyan, detections red\n"
+          "with class and score.\n\n"
           "Examples:\n"
           "  fusedet show --kitti ../shared/data/kitti --frame 000042 --out /tmp/k42.png\n"
           "  fusedet show --dataset /tmp/ds --item kitti/000000 --detections dets.json --out /tmp/d.png\n"

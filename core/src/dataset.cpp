@@ -106,7 +106,7 @@ fs::path itemDir(const fs::path& datasetDir, const std::string& id) { return dat
 json labelToJson(const Label& l) {
   return json{{"class", l.className}, {"source_class", l.sourceClass}, {"x", l.box.x}, {"y", l.box.y},
               {"w", l.box.w},         {"h", l.box.h},                  {"truncation", l.truncation},
-              {"occlusion", l.occlusion}, {"ignore", l.ignore}};
+              {"occlusion", l.occlusion}, {"ignore", l.ignore},                {"origin", l.origin}};
 }
 
 Label labelFromJson(const fs::path& file, const json& j, const std::string& where) {
@@ -119,6 +119,11 @@ Label labelFromJson(const fs::path& file, const json& j, const std::string& wher
   l.truncation = getNumber(file, j, "truncation", where);
   l.occlusion = static_cast<int>(getInt(file, j, "occlusion", where, -1, 3));
   l.ignore = getBool(file, j, "ignore", where);
+  // Optional: data sets written before labels had an origin were labelled by people.
+  if (j.contains("origin")) {
+    l.origin = getString(file, j, "origin", where);
+    if (l.origin != "human" && l.origin != "teacher") fail(file, where + ".origin must be \"human\" or \"teacher\"");
+  }
   return l;
 }
 

@@ -31,6 +31,11 @@ Label label(const std::string& cls, double x, double y, double w, double h, bool
   return l;
 }
 
+Label teacher(Label l) {
+  l.origin = "teacher";
+  return l;
+}
+
 // A data set of three 64x48 items in two groups, labelled with every kind of label.
 fs::path makeDataset(const std::string& name) {
   const fs::path dir = fs::path(testing::TempDir()) / ("label_exchange_" + name);
@@ -40,7 +45,8 @@ fs::path makeDataset(const std::string& name) {
        {label("car", 10.25, 5.5, 20, 12.75, false, 1, 0.25), label("person", 40, 8, 6, 18, false, 2),
         label("DontCare", 0, 30, 15, 10, true, -1, -1)}},
       {"drive_a/000002",
-       {label("bike", 3, 4, 12.5, 9, false, 0, 0.5), label("Truck", 20, 20, 30, 20, true, 0)}},
+       {label("bike", 3, 4, 12.5, 9, false, 0, 0.5), label("Truck", 20, 20, 30, 20, true, 0),
+        teacher(label("car", 33, 2, 20, 11.5))}},
       {"drive_b/000001", {}}};
   for (const auto& [id, labels] : items) {
     DatasetItem item;
@@ -73,6 +79,9 @@ void expectSameLabels(const std::vector<Labels>& a, const std::vector<Labels>& b
       SCOPED_TRACE("item " + std::to_string(i) + " label " + std::to_string(k));
       EXPECT_EQ(a[i][k].className, b[i][k].className);
       EXPECT_EQ(a[i][k].ignore, b[i][k].ignore);
+      if (withOcclusionAndTruncation) {
+        EXPECT_EQ(a[i][k].origin, b[i][k].origin);
+      }
       EXPECT_NEAR(a[i][k].box.x, b[i][k].box.x, tolerance);
       EXPECT_NEAR(a[i][k].box.y, b[i][k].box.y, tolerance);
       EXPECT_NEAR(a[i][k].box.w, b[i][k].box.w, tolerance);
@@ -92,7 +101,7 @@ TEST(LabelExchange, CocoRoundTripKeepsEveryLabel) {
   clearLabels(dir);
   const auto result = applyExchangeImages(dir, imagesFromCoco(coco, {}, "test.json"));
   EXPECT_EQ(result.items, 3u);
-  EXPECT_EQ(result.labels, 5u);
+  EXPECT_EQ(result.labels, 6u);
   expectSameLabels(before, labelsOf(dir), 1e-9, true);
 }
 
@@ -116,7 +125,10 @@ TEST(LabelExchange, KittiRoundTripKeepsEveryLabelToTwoDecimals) {
   EXPECT_TRUE(fs::exists(out / "drive_a" / "000002.txt"));
   clearLabels(dir);
   applyExchangeImages(dir, readKittiLabelFiles(out, {}));
-  expectSameLabels(before, labelsOf(dir), 0.005, true);
+  auto expected = before;  // KITTI files have no origin: every box reads back as a person's
+  for (Labels& labels : expected)
+    for (Label& l : labels) l.origin = "human";
+  expectSameLabels(expected, labelsOf(dir), 0.005, true);
 }
 
 // A COCO file as COCO-style tools write it (hand-written here, not by our writer): category ids

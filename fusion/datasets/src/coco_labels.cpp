@@ -74,7 +74,8 @@ json cocoFromImages(const std::vector<ExchangeImage>& images) {
                              {"area", l.box.w * l.box.h},
                              {"iscrowd", l.ignore ? 1 : 0},
                              {"occlusion", l.occlusion},
-                             {"truncation", l.truncation}});
+                             {"truncation", l.truncation},
+                             {"origin", l.origin}});
   }
   json categories = json::array();
   for (const auto& [name, id] : categoryIds)
@@ -152,6 +153,10 @@ std::vector<ExchangeImage> imagesFromCoco(const json& coco, const LabelClassTabl
       l.occlusion = static_cast<int>(o);
     }
     if (a.contains("truncation")) l.truncation = finite(file, a["truncation"], where + ".truncation");
+    if (a.contains("origin")) {
+      if (a["origin"] != "human" && a["origin"] != "teacher") fail(file, where + ".origin must be \"human\" or \"teacher\"");
+      l.origin = a["origin"].get<std::string>();
+    }
     images[image->second].labels.push_back(std::move(l));
   }
   return images;

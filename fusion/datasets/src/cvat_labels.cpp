@@ -94,7 +94,7 @@ std::string cvatFromImages(const std::vector<ExchangeImage>& images, const std::
     for (const Label& l : image.labels) {
       char trunc[32];
       std::snprintf(trunc, sizeof trunc, "%.4g", l.truncation);
-      xml += "    <box label=\"" + escape(l.className) + "\" source=\"manual\" occluded=\"" +
+      xml += "    <box label=\"" + escape(l.className) + "\" source=\"" + (l.origin == "teacher" ? "auto" : "manual") + "\" occluded=\"" +
              (l.occlusion >= 1 ? "1" : "0") + "\" xtl=\"" + number(l.box.x) + "\" ytl=\"" + number(l.box.y) +
              "\" xbr=\"" + number(l.box.x + l.box.w) + "\" ybr=\"" + number(l.box.y + l.box.h) +
              "\" z_order=\"0\">\n      <attribute name=\"occlusion\">" + std::to_string(l.occlusion) +
@@ -148,6 +148,8 @@ CvatLabels imagesFromCvat(const std::string& xml, const LabelClassTable& table, 
                    ybr = attributeNumber(file, shape, "ybr", boxWhere);
       if (xbr < xtl || ybr < ytl) fail(file, boxWhere + ": xbr/ybr lie before xtl/ytl");
       l.box = Box{xtl, ytl, xbr - xtl, ybr - ytl};
+      // CVAT marks boxes a model drew "auto"; one a person drew or corrected is "manual"/"semi-auto".
+      if (const char* source = shape->Attribute("source")) l.origin = std::string(source) == "auto" ? "teacher" : "human";
       if (const char* occluded = shape->Attribute("occluded"))
         l.occlusion = std::string(occluded) == "1" ? 1 : 0;
       for (const auto* a = shape->FirstChildElement("attribute"); a; a = a->NextSiblingElement("attribute")) {

@@ -27,15 +27,18 @@ void drawBoxes(cv::Mat& tile, double scale, const Labels& labels, const std::vec
   const auto rect = [scale](const Box& b) {
     return cv::Rect(cvRound(b.x * scale), cvRound(b.y * scale), cvRound(b.w * scale), cvRound(b.h * scale));
   };
+  const cv::Scalar teacherColour(255, 255, 0);  // cyan: a network drew it, a person should check it
   for (const Label& l : labels) {
+    const bool teacher = l.origin == "teacher";
     if (l.ignore) {
-      dashedRect(tile, rect(l.box), cv::Scalar(170, 170, 170));
+      dashedRect(tile, rect(l.box), teacher ? teacherColour : cv::Scalar(170, 170, 170));
       continue;
     }
-    const cv::Scalar colour = l.className == "van" ? cv::Scalar(0, 165, 255) : cv::Scalar(0, 220, 0);
+    const cv::Scalar colour = teacher ? teacherColour : l.className == "van" ? cv::Scalar(0, 165, 255) : cv::Scalar(0, 220, 0);
     const cv::Rect r = rect(l.box);
-    cv::rectangle(tile, r, colour, 2);
-    cv::putText(tile, l.className, r.tl() + cv::Point(2, 14), cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
+    cv::rectangle(tile, r, colour, teacher ? 1 : 2);
+    cv::putText(tile, teacher ? l.className + " (teacher)" : l.className, r.tl() + cv::Point(2, 14),
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
   }
   for (const Detection& d : detections) {
     const cv::Rect r = rect(d.box);

@@ -18,6 +18,7 @@ struct Label {
   double truncation = 0;    // KITTI object: fraction [0,1]; KITTI tracking: level 0, 1, 2
   int occlusion = 0;        // 0 fully visible .. 3 unknown (KITTI)
   bool ignore = false;      // ignore region
+  std::string origin = "human";  // who drew it: "human" or "teacher" (a network: fusedet autolabel)
 };
 
 using Labels = std::vector<Label>;

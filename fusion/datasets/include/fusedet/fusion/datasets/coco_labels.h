@@ -7,7 +7,8 @@
 // region that is neither hit nor miss, which is our ignore region. person, bicycle and car keep
 // COCO's own category ids (1, 2, 3), so files line up with COCO-trained tools.
 // Occlusion and truncation, which COCO has no field for, travel as extra annotation keys
-// "occlusion" and "truncation" (COCO readers skip keys they do not know).
+// "occlusion" and "truncation", and who drew the box as "origin" (human | teacher) (COCO readers
+// skip keys they do not know).
 
 #include <nlohmann/json.hpp>
 #include <string>

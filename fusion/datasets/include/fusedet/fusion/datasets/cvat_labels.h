@@ -4,7 +4,8 @@
 // <version>1.1</version>, a <meta><task> naming the labels, and per image <image id name width
 // height> holding <box label occluded xtl ytl xbr ybr> (corners in pixels). Our occlusion level,
 // truncation and ignore flag travel as box attributes "occlusion", "truncation", "ignore"
-// (declared in the meta, so CVAT shows them); occluded = occlusion level >= 1.
+// (declared in the meta, so CVAT shows them); occluded = occlusion level >= 1. A teacher's box is
+// source="auto"; a box a person drew or corrected (manual, semi-auto) reads back as human.
 // Shapes other than boxes (polygons, points, ...) carry no box: the reader counts and skips them.
 
 #include <string>

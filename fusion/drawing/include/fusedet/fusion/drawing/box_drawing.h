@@ -2,7 +2,9 @@
 #pragma once
 // Labels and detections drawn on an 8-bit BGR image: the one box-drawing rule of the project
 // (`fusedet show`'s mosaics, `fusedet detect --draw`). Labels: green (car/person/bike/...),
-// orange ("van"), grey dashed ignore regions; detections: red with class and score.
+// orange ("van"), grey dashed ignore regions; labels a teacher network drew (origin "teacher",
+// fusedet autolabel): cyan, thin, "(teacher)" after the class, its ignore regions cyan dashed;
+// detections: red with class and score.
 
 #include <opencv2/core/mat.hpp>
 #include <vector>

@@ -23,9 +23,8 @@ struct MosaicOptions {
 // Display mapping per layer: 8-bit as grey; hue as its colour (full saturation and value);
 // distance with a colour map (near = red, far = blue), invalid cells black; remission and other
 // float layers stretched from their valid range to grey; filled (interpolated) laser cells are
-// shown like measured ones. Labels: green (car/person/bike/...), orange ("van"), grey dashed
-// ignore regions; detections: red with class and score. Throws std::invalid_argument for an
-// empty stack or options out of range.
+// shown like measured ones. Labels and detections as box_drawing.h draws them. Throws
+// std::invalid_argument for an empty stack or options out of range.
 cv::Mat renderMosaic(const LayerStack& stack, const Labels& labels, const std::vector<Detection>& detections,
                      const MosaicOptions& options = {});
 
