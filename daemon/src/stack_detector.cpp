@@ -41,7 +41,29 @@ std::vector<boosting::ClassGrouping> classGroupingFrom(const Config::Detection& 
   return out;
 }
 
-CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem::path& base)
+namespace {
+
+// A model trained on layers the daemon's stacks do not have would fail on every stack: refuse it
+// when it is loaded (at start, or at reload, where the old models then keep serving).
+void checkLayers(const boosting::Cascade& cascade, const std::filesystem::path& file, const std::vector<std::string>& stackLayers) {
+  const auto made = [&](const std::string& name) {
+    return std::find(stackLayers.begin(), stackLayers.end(), name) != stackLayers.end();
+  };
+  for (const std::string& name : cascade.layers) {
+    if (made(name) || (name == layer::kHueDistance && made(std::string(layer::kHue)))) continue;
+    std::string list;
+    for (const std::string& l : stackLayers) list += (list.empty() ? "" : ", ") + l;
+    if (made(std::string(layer::kHue))) list += ", hue_distance";
+    throw std::runtime_error(file.string() + ": the model (class '" + cascade.className + "') uses layer '" + name +
+                             "', which fusedetd's stacks do not have (" + list +
+                             "); train it on those layers (fusedet train --layers)");
+  }
+}
+
+}  // namespace
+
+CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem::path& base,
+                       const std::vector<std::string>& stackLayers)
     : scan_(scanParamsFrom(settings)),
       group_(groupParamsFrom(settings)),
       extent_(laserExtentFrom(settings)),
@@ -53,6 +75,7 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
     std::filesystem::path file = m;
     if (file.is_relative() && !base.empty()) file = base / file;
     boosting::Cascade cascade = boosting::loadModel(file);
+    checkLayers(cascade, file, stackLayers);
     if (!seen.insert(cascade.className).second)
       throw std::runtime_error(file.string() + ": a second model of class '" + cascade.className + "'");
     cascades.push_back(std::move(cascade));

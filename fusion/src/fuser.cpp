@@ -24,6 +24,12 @@ Fuser::Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, 
   if (config_.holeFillRadius < 0) throw std::invalid_argument("hole fill radius must be >= 0");
 }
 
+std::vector<std::string> Fuser::layerNames() {
+  return {std::string(layer::kRed),       std::string(layer::kGreen),    std::string(layer::kBlue),
+          std::string(layer::kIntensity), std::string(layer::kHue),      std::string(layer::kDistance),
+          std::string(layer::kRemission)};
+}
+
 LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings) const {
   FuseTimings t;
   const auto start = Clock::now();

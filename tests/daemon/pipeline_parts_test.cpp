@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "fusedet/daemon/bounded_queue.h"
@@ -12,6 +14,7 @@
 #include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/stack_detector.h"
 #include "fusedet/daemon/stats.h"
+#include "fusedet/fusion/fuser.h"
 #include "fusedet/fusion/projection.h"
 
 using namespace fusedet;
@@ -237,6 +240,35 @@ TEST(DetectionSettings, ClassSettingsWithoutAModelAreReported) {
   EXPECT_TRUE(CascadeSet(d).unmatchedClassSettings().empty());
   d.classes = {{"car", 16, true}, {"cars", 4, false}, {"person", 5, false}};
   EXPECT_EQ(CascadeSet(d).unmatchedClassSettings(), (std::vector<std::string>{"cars", "person"}));
+}
+
+// A model trained on a layer the daemon's stacks do not have (here the bundled car model with a
+// neural score layer added to its layer list) is refused when loaded, naming the file,
+// the layer and the layers fusion makes; hue_distance counts as made (derived from hue).
+TEST(DetectionSettings, AModelNeedingALayerTheStacksLackIsRefused) {
+  nlohmann::json car = nlohmann::json::parse(std::ifstream(std::string(FUSEDET_SOURCE_DIR) + "/models/car.json"));
+  car["layers"].push_back("neural_car");
+  const std::string file = testing::TempDir() + "/car_neural.json";
+  std::ofstream(file) << car.dump();
+  Config::Detection d;
+  d.models = {file};
+  try {
+    CascadeSet set(d);
+    FAIL() << "loaded a model needing neural_car";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(file + ": the model (class 'car') uses layer 'neural_car', which fusedetd's stacks do not have "
+                               "(red, green, blue, intensity, hue, distance, remission, hue_distance)"),
+              std::string::npos)
+        << what;
+  }
+  // The same file is fine for stacks that have the layer.
+  std::vector<std::string> layers = fusion::Fuser::layerNames();
+  layers.push_back("neural_car");
+  EXPECT_EQ(CascadeSet(d, {}, layers).classes(), std::vector<std::string>{"car"});
+  // Without hue, a model using hue_distance cannot run either.
+  d.models = {std::string(FUSEDET_SOURCE_DIR) + "/models/car.json"};
+  EXPECT_THROW(CascadeSet(d, {}, {"red", "green", "blue", "intensity", "distance", "remission"}), std::runtime_error);
 }
 
 // detection.classes: each entry inherits the general min_neighbors / laser_extent it leaves out;

@@ -200,6 +200,18 @@ TEST(Service, ReloadUnderLoadKeepsClientsAndABadFileKeepsTheOldModels) {
   EXPECT_NE(service.summary().find("reload failed"), std::string::npos);
   EXPECT_EQ(service.status()["last_reload_error"], error);
 
+  // A model needing a layer the stacks lack is refused at reload too; the old models keep serving.
+  nlohmann::json neural = nlohmann::json::parse(std::ifstream(model("bike")));
+  neural["layers"].push_back("neural_bicycle");
+  const std::string neuralFile = testing::TempDir() + "/bike_neural.json";
+  std::ofstream(neuralFile) << neural.dump();
+  Config needsNeural = config;
+  needsNeural.detection.models = {neuralFile};
+  const std::string layerError = service.reload(needsNeural);
+  EXPECT_NE(layerError.find("uses layer 'neural_bicycle', which fusedetd's stacks do not have"), std::string::npos)
+      << layerError;
+  EXPECT_EQ(service.hello()["classes"], nlohmann::json({"car", "bike", "person"}));
+
   Config good = config;
   good.detection.models = {model("bike")};
   EXPECT_EQ(service.reload(good), "");

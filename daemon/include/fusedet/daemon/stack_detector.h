@@ -16,6 +16,7 @@
 #include "fusedet/core/detection.h"
 #include "fusedet/core/layer_stack.h"
 #include "fusedet/daemon/config.h"
+#include "fusedet/fusion/fuser.h"
 
 namespace fusedet::daemon {
 
@@ -37,8 +38,11 @@ std::vector<boosting::ClassGrouping> classGroupingFrom(const Config::Detection& 
 class CascadeSet : public StackDetector {
  public:
   // Loads every model file (relative paths against `base`); throws std::runtime_error naming the
-  // file and the problem (missing, malformed, invalid cascade, two models of one class).
-  CascadeSet(const Config::Detection& settings, const std::filesystem::path& base = {});
+  // file and the problem (missing, malformed, invalid cascade, two models of one class, a layer the
+  // stacks will not have: `stackLayers` are the layers fusion makes, fusion::Fuser::layerNames(),
+  // plus hue_distance when hue is among them).
+  CascadeSet(const Config::Detection& settings, const std::filesystem::path& base = {},
+             const std::vector<std::string>& stackLayers = fusion::Fuser::layerNames());
 
   std::vector<Detection> detect(const LayerStack& stack) const override;
   std::vector<std::string> classes() const override;

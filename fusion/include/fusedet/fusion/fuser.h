@@ -30,6 +30,10 @@ class Fuser {
   // and source are left to the caller.
   LayerStack fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings = nullptr) const;
 
+  // The layers fuse() makes, in its order (a model needing any other cannot run on its stacks;
+  // hue_distance is derived from hue per model at detection time).
+  static std::vector<std::string> layerNames();
+
   const PinholeProjection& projection() const { return projection_; }
   const ProjectionConfig& config() const { return config_; }
   const Undistorter& undistorter() const { return undistorter_; }
