@@ -5,11 +5,13 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "command.h"
+#include "fusedet/fusion/datasets/coco_labels.h"
 #include "experiments/report.h"
 #include "fusedet/boost/chain_evaluation.h"
 #include "fusedet/boost/class_rules.h"
@@ -29,6 +31,7 @@ struct EvalOptions {
   std::string split = "test";
   double trainFraction = 2.0 / 3.0;
   bool json = false;
+  fs::path cocoResults;
   double minIou = 0, minHeight = 25, maxTruncation = 0.3;
   int maxOcclusion = 1;
   std::string van = "ignore";
@@ -93,6 +96,15 @@ int runEval(const EvalOptions& o) {
   for (const auto& d : detectors) chain.push_back(&d);
   const boosting::EvalOutcome r = boosting::evaluateChain(chain, items, match, setup);
   const std::optional<double> ap = boosting::averagePrecision(boosting::allFrames(r.frames));
+  if (!o.cocoResults.empty()) {
+    std::vector<std::pair<std::string, std::vector<Detection>>> perItem;
+    for (std::size_t i = 0; i < entries.size(); ++i) perItem.emplace_back(entries[i].id, r.detections[i]);
+    std::vector<std::string> manifestIds;
+    for (const DatasetEntry& e : manifest) manifestIds.push_back(e.id);
+    std::ofstream out(o.cocoResults);
+    if (!(out << fusion::cocoResults(manifestIds, perItem).dump() << "\n") || !out.flush())
+      throw std::runtime_error(o.cocoResults.string() + ": cannot write");
+  }
   const auto orNull = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   const boosting::CascadeSummary s = summaries.size() == 1 ? summaries.front() : boosting::combineSummaries(summaries);
 
@@ -163,6 +175,9 @@ const bool registered = registerCommand(
           ->required()
           ->check(CLI::ExistingFile);
       app.add_option("--data", o->data, "data set directory (dataset.json; see docs/dataset-format.md)")->required();
+      app.add_option("--coco-results", o->cocoResults,
+                     "also write every detection as a COCO results file (image ids as `fusedet dataset export "
+                     "--format coco` gives them, COCO's category ids), for COCO-style evaluation tools");
       app.add_option("--split", o->split,
                      "frames to evaluate: test (the last third of each group's frames), train (the first two "
                      "thirds), all")

@@ -4,9 +4,11 @@
 # an independent reader against KITTI's own label text (coco_check.py); labels cleared, then brought
 # back from each format (CVAT, KITTI, COCO) with the same counts; split by group and merged back;
 # refusals leave the labels as they were.
-#   dataset_labels_test.sh FUSEDET DATA_DIR WORKDIR
+# Detections of the bundled car model as COCO results: image ids of the export, COCO's car id, as
+# many results as eval counted detections.
+#   dataset_labels_test.sh FUSEDET DATA_DIR WORKDIR CAR_MODEL
 set -euo pipefail
-fusedet=$1 data=$2 work=$3
+fusedet=$1 data=$2 work=$3 car=$4
 here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work" && mkdir -p "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
@@ -17,6 +19,21 @@ ds=$work/ds
 
 "$fusedet" dataset export "$ds" --format coco --out "$work/labels.json"
 python3 "$here/coco_check.py" "$work/labels.json" "$work/info0.json" "$data/kitti" "$data/kitti_0009"
+"$fusedet" eval --model "$car" --data "$ds" --split all --json --coco-results "$work/results.json" > "$work/eval.json"
+python3 - "$work/labels.json" "$work/results.json" "$work/eval.json" <<'PY' || fail "COCO results do not fit the export"
+import json, math, sys
+labels, results, ev = (json.load(open(f)) for f in sys.argv[1:4])
+images = {im["id"] for im in labels["images"]}
+assert isinstance(results, list) and results, "no results"
+for r in results:
+    assert set(r) == {"image_id", "category_id", "bbox", "score"}, r
+    assert r["image_id"] in images, f"image_id {r['image_id']} is no image of the export"
+    assert r["category_id"] == 3, f"car must be COCO category 3: {r}"
+    assert len(r["bbox"]) == 4 and all(math.isfinite(v) for v in r["bbox"]) and r["bbox"][2] > 0 and r["bbox"][3] > 0, r
+counted = ev["hits"] + ev["false_alarms"] + ev["ignored_detections"]
+assert len(results) == counted, f"{len(results)} results, eval counted {counted} detections"
+print(f"COCO results: {len(results)} car detections on {len({r['image_id'] for r in results})} export images, as eval counted")
+PY
 "$fusedet" dataset export "$ds" --format cvat --out "$work/labels.xml"
 "$fusedet" dataset export "$ds" --format kitti --out "$work/label_2"
 

@@ -5,6 +5,7 @@
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 namespace fusedet::fusion {
 using nlohmann::json;
@@ -48,6 +49,27 @@ const json& array(const std::string& file, const json& coco, const char* key) {
 
 std::string cocoClassName(const std::string& projectClass) {
   return projectClass == "bike" ? "bicycle" : projectClass;
+}
+
+json cocoResults(const std::vector<std::string>& manifestIds,
+                 const std::vector<std::pair<std::string, std::vector<Detection>>>& detectionsPerItem) {
+  std::map<std::string, int> imageIds;
+  for (std::size_t i = 0; i < manifestIds.size(); ++i) imageIds.emplace(manifestIds[i], static_cast<int>(i) + 1);
+  json results = json::array();
+  for (const auto& [item, detections] : detectionsPerItem) {
+    const auto image = imageIds.find(item);
+    if (image == imageIds.end()) throw std::invalid_argument("COCO results: item '" + item + "' is not in the data set");
+    for (const Detection& d : detections) {
+      const auto category = kCocoIds.find(cocoClassName(d.className));
+      if (category == kCocoIds.end())
+        throw std::invalid_argument("COCO results: class '" + d.className + "' has no COCO category");
+      results.push_back({{"image_id", image->second},
+                         {"category_id", category->second},
+                         {"bbox", {d.box.x, d.box.y, d.box.w, d.box.h}},
+                         {"score", d.score}});
+    }
+  }
+  return results;
 }
 
 json cocoFromImages(const std::vector<ExchangeImage>& images) {

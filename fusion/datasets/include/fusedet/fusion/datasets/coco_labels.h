@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "fusedet/core/detection.h"
 #include "fusedet/fusion/datasets/label_exchange.h"
 
 namespace fusedet::fusion {
@@ -26,5 +27,13 @@ std::vector<ExchangeImage> imagesFromCoco(const nlohmann::json& coco, const Labe
 
 // The COCO name of a project class: "bike" -> "bicycle"; person and car as they are.
 std::string cocoClassName(const std::string& projectClass);
+
+// Detections as a COCO results file ([{"image_id", "category_id", "bbox", "score"}], what COCO's
+// evaluation reads beside the labels): image ids as cocoFromImages gives them to the data set's
+// items (1 + the item's place in the manifest, `manifestIds`), category ids of COCO (person 1,
+// bicycle 2, car 3). Throws std::invalid_argument for an item id not in the manifest or a class
+// without a COCO category.
+nlohmann::json cocoResults(const std::vector<std::string>& manifestIds,
+                           const std::vector<std::pair<std::string, std::vector<Detection>>>& detectionsPerItem);
 
 }  // namespace fusedet::fusion
