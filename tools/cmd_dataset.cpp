@@ -12,6 +12,8 @@
 #include <sstream>
 
 #include "command.h"
+#include "data_dir.h"
+#include "fusedet/fusion/datasets/kitti_drives.h"
 #include "fusedet/core/dataset.h"
 #include "fusedet/fusion/datasets/coco_labels.h"
 #include "fusedet/fusion/datasets/cvat_labels.h"
@@ -31,7 +33,8 @@ struct DatasetOptions {
   std::vector<std::string> maps;
   bool allowUnmatched = false;
   bool json = false;
-  std::string by = "group";
+  std::string by = "log";
+  fs::path kittiRoot = defaultDataDir();
 };
 
 std::string readText(const fs::path& file) {
@@ -172,11 +175,28 @@ int runMerge(const DatasetOptions& o) {
   return 0;
 }
 
+// The part an item goes to: its group (the log or KITTI folder it came from), or for --by drive the
+// raw KITTI drive its folder's SOURCE.md names (fusedet/fusion/datasets/kitti_drives.h).
+std::map<std::string, std::vector<DatasetEntry>> splitParts(const DatasetOptions& o) {
+  if (o.by != "log" && o.by != "group" && o.by != "drive")
+    throw std::runtime_error("--by '" + o.by + "': use log (the item's group) or drive (KITTI's raw drive)");
+  std::map<std::string, fusion::KittiDriveMap> driveMaps;
+  std::map<std::string, std::vector<DatasetEntry>> parts;
+  for (const DatasetEntry& e : readDatasetManifest(o.dataset)) {
+    if (o.by != "drive") {
+      parts[e.group].push_back(e);
+      continue;
+    }
+    if (!driveMaps.contains(e.group)) driveMaps[e.group] = fusion::readKittiDriveMap(o.kittiRoot / e.group);
+    const std::string source = readDatasetItemLabels(o.dataset, e.id).stack.source;
+    const std::string frame = source.substr(source.rfind('/') + 1);
+    parts[driveMaps[e.group].driveOf(frame, e.group)].push_back(e);
+  }
+  return parts;
+}
+
 int runSplit(const DatasetOptions& o) {
-  if (o.by != "group") throw std::runtime_error("--by '" + o.by + "': data sets split by group");
-  std::map<std::string, std::vector<DatasetEntry>> byGroup;
-  for (const DatasetEntry& e : readDatasetManifest(o.dataset)) byGroup[e.group].push_back(e);
-  for (const auto& [group, entries] : byGroup) {
+  for (const auto& [group, entries] : splitParts(o)) {
     const bool safe =
         !group.empty() && group != "." && group != ".." &&
         group.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
@@ -228,15 +248,18 @@ const bool registered = registerCommand(
       merge->add_option("--out", o->out, "the data set to write (new, or one whose ids do not clash)")
           ->required();
 
-      CLI::App* split = app.add_subcommand("split", "one data set per group (drive or log) under a folder");
+      CLI::App* split = app.add_subcommand("split", "one data set per log (the item's group) or per raw KITTI drive, under a folder");
       split->add_option("DATASET", o->dataset, "a data set folder")
           ->required()
           ->check(CLI::ExistingDirectory);
       split
           ->add_option("--by", o->by,
-                       "group: the item's group, i.e. the KITTI folder or the log it came from")
+                       "log: the item's group (the log or KITTI folder it came from); drive: the raw KITTI drive "
+                       "its folder's SOURCE.md names (object-benchmark folders mix drives)")
           ->capture_default_str();
-      split->add_option("--out", o->out, "folder for OUT/<group>/")->required();
+      split->add_option("--kitti-root", o->kittiRoot, "--by drive: where the KITTI folders (and their SOURCE.md) are")
+          ->capture_default_str();
+      split->add_option("--out", o->out, "folder for OUT/<log or drive>/")->required();
 
       app.footer(
           "Labelling files name each image <item id>.png (e.g. kitti_0009/000004.png); import finds the item "
@@ -262,7 +285,8 @@ const bool registered = registerCommand(
           "  fusedet dataset export data/kitti_set --format coco --out instances.json\n"
           "  fusedet dataset import data/robot_set coco.json --format coco --map motorcycle=ignore\n"
           "  fusedet dataset merge data/a data/b --out data/ab\n"
-          "  fusedet dataset split data/ab --by group --out data/per-drive\n"
+          "  fusedet dataset split data/ab --by log --out data/per-log\n"
+          "  fusedet dataset split data/kitti_set --by drive --out data/per-drive   # KITTI's raw drives\n"
           "Exit status: 0 done; 1 on errors ('fusedet dataset: error: ...'), which name the file and field.");
       return [o, info, exp, imp, merge, split]() -> int {
         if (info->parsed()) return runInfo(*o);

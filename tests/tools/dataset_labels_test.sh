@@ -65,10 +65,15 @@ cat "$work/err.txt"
 "$fusedet" dataset info "$ds" --json | cmp -s - "$work/info0.json" || fail "a refused import changed labels"
 
 # Split by group and merged back: the same data set.
-"$fusedet" dataset split "$ds" --by group --out "$work/groups"
+"$fusedet" dataset split "$ds" --by log --out "$work/groups"
 [ -f "$work/groups/kitti/dataset.json" ] && [ -f "$work/groups/kitti_0009/dataset.json" ] || fail "split wrote no per-group data sets"
 "$fusedet" dataset merge "$work/groups/kitti" "$work/groups/kitti_0009" --out "$work/merged"
 "$fusedet" dataset info "$work/merged" --json | cmp -s - "$work/info0.json" || fail "split + merge changed the data set"
+# By raw drive: kitti and kitti_0009 are KITTI drives 0005 and 0009 (their SOURCE.md headings).
+"$fusedet" dataset split "$ds" --by drive --kitti-root "$data" --out "$work/drives"
+ls "$work/drives"
+[ -f "$work/drives/2011_09_26_drive_0005/dataset.json" ] && [ -f "$work/drives/2011_09_26_drive_0009/dataset.json" ] ||
+  fail "split --by drive did not name the raw drives"
 rc=0; "$fusedet" dataset merge "$work/groups/kitti" --out "$work/merged" 2> "$work/err.txt" || rc=$?
 [ $rc -eq 1 ] && grep -qF "is already in" "$work/err.txt" || fail "merge over existing ids not refused"
 echo "dataset_labels_test: PASS"
