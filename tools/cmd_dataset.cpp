@@ -19,6 +19,7 @@
 #include "fusedet/fusion/datasets/cvat_labels.h"
 #include "fusedet/fusion/datasets/kitti_label_files.h"
 #include "fusedet/fusion/datasets/label_exchange.h"
+#include "fusedet/sensor_logs/dataset_from_log.h"
 
 namespace fusedet::tools {
 namespace {
@@ -34,6 +35,8 @@ struct DatasetOptions {
   bool allowUnmatched = false;
   bool json = false;
   std::string by = "log";
+  fs::path log;
+  sensor_logs::FromLogOptions fromLog;
   fs::path kittiRoot = defaultDataDir();
 };
 
@@ -144,6 +147,15 @@ int runImport(const DatasetOptions& o) {
   return 0;
 }
 
+int runFromLog(const DatasetOptions& o) {
+  const sensor_logs::FromLogReport r = sensor_logs::datasetFromLog(o.log, o.out, o.fromLog);
+  if (!r.damage.empty()) std::fprintf(stderr, "dataset from-log: %s: %s\n", o.log.c_str(), r.damage.c_str());
+  std::printf("from-log %s: %ju stacks fused, %ju items written to %s (group %s)%s\n", o.log.c_str(),
+              static_cast<std::uintmax_t>(r.stacks), static_cast<std::uintmax_t>(r.written), o.out.c_str(),
+              r.group.c_str(), o.fromLog.images ? ", camera images in images/" : "");
+  return r.written > 0 ? 0 : 3;
+}
+
 // Copies one item (every layer) into another data set, refusing to replace one there.
 void copyItem(const fs::path& from, const DatasetEntry& entry, const fs::path& to,
               std::set<std::string>& taken) {
@@ -222,6 +234,19 @@ const bool registered = registerCommand(
           ->check(CLI::ExistingDirectory);
       info->add_flag("--json", o->json, "one JSON object instead of text lines");
 
+      CLI::App* fromLog = app.add_subcommand(
+          "from-log", "data set items from a recorded sensor log, fused as fusedetd fuses it (no labels yet)");
+      fromLog->add_option("LOG", o->log, "an MCAP sensor log with its rig (fusedet record, fusedet synth-log)")
+          ->required()
+          ->check(CLI::ExistingFile);
+      fromLog->add_option("--out", o->out, "the data set to write (created, or added to)")->required();
+      fromLog->add_option("--every", o->fromLog.every, "keep every n-th fused stack")->capture_default_str();
+      fromLog->add_option("--stride-s", o->fromLog.strideSeconds,
+                          "keep a stack only this many seconds after the last kept one (0: no limit)")
+          ->capture_default_str();
+      fromLog->add_option("--group", o->fromLog.group, "the items' group (default: the log's file name)");
+      fromLog->add_flag("!--no-images", o->fromLog.images, "do not write images/<id>.png for labelling");
+
       CLI::App* exp =
           app.add_subcommand("export", "write the labels of every item as a labelling tool's file");
       exp->add_option("DATASET", o->dataset, "a data set folder")->required()->check(CLI::ExistingDirectory);
@@ -262,6 +287,9 @@ const bool registered = registerCommand(
       split->add_option("--out", o->out, "folder for OUT/<log or drive>/")->required();
 
       app.footer(
+          "from-log replays the log through fusedetd's own pipeline (decoders, sweep assembly, pairing, fusion) with\n"
+          "the rig and calibration the log carries; each kept stack becomes item <group>/<stack id> and its camera\n"
+          "image OUT/images/<group>/<stack id>.png, the name labelling files use (exit 3 when no stack was fused).\n"
           "Labelling files name each image <item id>.png (e.g. kitti_0009/000004.png); import finds the item "
           "by\n"
           "that name, or by its last part when only one item ends so, and refuses a file whose image size "
@@ -279,6 +307,7 @@ const bool registered = registerCommand(
           "travel as\n"
           "KITTI fields, CVAT attributes, and extra COCO annotation keys.\n"
           "Examples:\n"
+          "  fusedet dataset from-log run.mcap --out data/robot --stride-s 2   # a stack every 2 s\n"
           "  fusedet dataset info data/kitti_set\n"
           "  fusedet dataset export data/kitti_set --format cvat --out labels.xml   # open in CVAT, correct\n"
           "  fusedet dataset import data/kitti_set labels-corrected.xml --format cvat\n"
@@ -288,8 +317,9 @@ const bool registered = registerCommand(
           "  fusedet dataset split data/ab --by log --out data/per-log\n"
           "  fusedet dataset split data/kitti_set --by drive --out data/per-drive   # KITTI's raw drives\n"
           "Exit status: 0 done; 1 on errors ('fusedet dataset: error: ...'), which name the file and field.");
-      return [o, info, exp, imp, merge, split]() -> int {
+      return [o, info, fromLog, exp, imp, merge, split]() -> int {
         if (info->parsed()) return runInfo(*o);
+        if (fromLog->parsed()) return runFromLog(*o);
         if (exp->parsed()) return runExport(*o);
         if (imp->parsed()) return runImport(*o);
         if (merge->parsed()) return runMerge(*o);

@@ -2,20 +2,24 @@
 #include "fusedet/daemon/offline_replay.h"
 
 #include <chrono>
+#include <stdexcept>
 #include <thread>
 
 #include "fusedet/daemon/service_parts.h"
 
 namespace fusedet::daemon {
 
-OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
-                                  const std::filesystem::path& log,
-                                  const std::function<void(const StackResult&)>& onResult) {
+namespace {
+
+OfflineReplayReport run(Config config, const std::filesystem::path& configFile, const std::filesystem::path& log,
+                        std::shared_ptr<const StackDetector> detector,
+                        const std::function<void(const StackResult&)>& onResult) {
   config.replay.file = std::filesystem::absolute(log).string();
   config.replay.realtime = false;
   config.replay.restamp = false;
   config.replay.atEnd = "exit";
-  ServiceParts parts = replayParts(std::move(config), configFile);
+  ServiceParts parts = replayParts(std::move(config), configFile, detector == nullptr);
+  if (detector) parts.detector = std::move(detector);
   Pipeline pipeline(pipelineSetup(parts), parts.detector,
                     [&onResult](std::shared_ptr<const StackResult> r) { onResult(*r); });
   pipeline.start();
@@ -34,6 +38,21 @@ OfflineReplayReport replayOffline(Config config, const std::filesystem::path& co
     for (const SensorHealth& h : s->health())
       if (!h.lastError.empty()) report.damage += (report.damage.empty() ? "" : "; ") + h.lastError;
   return report;
+}
+
+}  // namespace
+
+OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
+                                  const std::filesystem::path& log,
+                                  const std::function<void(const StackResult&)>& onResult) {
+  return run(std::move(config), configFile, log, nullptr, onResult);
+}
+
+OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
+                                  const std::filesystem::path& log, std::shared_ptr<const StackDetector> detector,
+                                  const std::function<void(const StackResult&)>& onResult) {
+  if (!detector) throw std::invalid_argument("replayOffline: no detector");
+  return run(std::move(config), configFile, log, std::move(detector), onResult);
 }
 
 }  // namespace fusedet::daemon

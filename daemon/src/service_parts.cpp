@@ -26,7 +26,7 @@ ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
 
 // The log's rig (laser, tilt, camera, fusion) with this machine's detection, models and
 // socket; a missing or non-MCAP log is a start-up error naming the file.
-ServiceParts replayParts(Config config, const std::filesystem::path& configFile) {
+ServiceParts replayParts(Config config, const std::filesystem::path& configFile, bool withModels) {
   std::filesystem::path log = config.replay.file;
   if (log.is_relative()) log = configFile.parent_path() / log;
   ReplayRig rig;
@@ -47,7 +47,7 @@ ServiceParts replayParts(Config config, const std::filesystem::path& configFile)
   settings.loop = config.replay.atEnd == "loop";
   ServiceParts parts;
   parts.fuser = fuserFrom(rig.config, rig.camera);
-  parts.detector = detectorFrom(config, configFile);
+  if (withModels) parts.detector = detectorFrom(config, configFile);
   try {
     parts.sources.push_back(std::make_unique<ReplaySource>(settings));
   } catch (const std::exception& e) {

@@ -9,10 +9,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/pipeline.h"
+#include "fusedet/daemon/stack_detector.h"
 
 namespace fusedet::daemon {
 
@@ -27,6 +29,11 @@ struct OfflineReplayReport {
 // Throws std::runtime_error naming the log or model file when they cannot be used.
 OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
                                   const std::filesystem::path& log,
+                                  const std::function<void(const StackResult&)>& onResult);
+// The same with `detector` in place of the config's models (none are loaded): e.g. one that keeps
+// every fused stack (`fusedet dataset from-log`).
+OfflineReplayReport replayOffline(Config config, const std::filesystem::path& configFile,
+                                  const std::filesystem::path& log, std::shared_ptr<const StackDetector> detector,
                                   const std::function<void(const StackResult&)>& onResult);
 
 }  // namespace fusedet::daemon

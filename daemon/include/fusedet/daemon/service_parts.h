@@ -16,7 +16,8 @@ namespace fusedet::daemon {
 // std::runtime_error naming the file that is missing or bad (a log that is not MCAP, a camera
 // model, a model file).
 ServiceParts liveParts(Config config, const std::filesystem::path& configFile);
-ServiceParts replayParts(Config config, const std::filesystem::path& configFile);
+// withModels false: no detector (the caller brings one), so no model file is read.
+ServiceParts replayParts(Config config, const std::filesystem::path& configFile, bool withModels = true);
 // replayParts when replay.file is set, else liveParts.
 ServiceParts serviceParts(Config config, const std::filesystem::path& configFile);
 
