@@ -4,8 +4,10 @@
 #include <poll.h>
 #include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/sinks/systemd_sink.h>
 #include <spdlog/spdlog.h>
 #include <sys/signalfd.h>
+#include <sys/stat.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
@@ -23,6 +25,16 @@
 
 namespace fusedet::daemon {
 namespace {
+
+// True when stderr is the journal's stream (systemd sets JOURNAL_STREAM=<device>:<inode> of it,
+// systemd.exec(5)); not for a child that inherited the variable with stderr redirected.
+bool stderrIsJournal() {
+  const char* stream = std::getenv("JOURNAL_STREAM");
+  unsigned long long dev = 0, ino = 0;
+  struct stat st {};
+  if (!stream || std::sscanf(stream, "%llu:%llu", &dev, &ino) != 2 || ::fstat(STDERR_FILENO, &st) != 0) return false;
+  return st.st_dev == dev && st.st_ino == ino;
+}
 
 using Clock = std::chrono::steady_clock;
 // Past the stop budget (Service::stopBudget: the sources' stop times - the tilt motor is brought
@@ -91,9 +103,14 @@ int runDaemon(const RunOptions& options) {
   sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
   signal(SIGPIPE, SIG_IGN);
-  // Log lines go to stderr (the journal under systemd); stdout stays free.
-  spdlog::set_default_logger(spdlog::stderr_color_mt("fusedetd"));
-  spdlog::set_pattern("%^%l%$: %v");
+  // Log lines go to stderr; stdout stays free. Under systemd they go to the journal directly, each
+  // with its level as PRIORITY (error 3, warn 4, info 6, ...) and SYSLOG_IDENTIFIER=fusedetd.
+  if (stderrIsJournal()) {
+    spdlog::set_default_logger(spdlog::systemd_logger_mt("fusedetd", "fusedetd"));
+  } else {
+    spdlog::set_default_logger(spdlog::stderr_color_mt("fusedetd"));
+    spdlog::set_pattern("%^%l%$: %v");
+  }
   drivers::UniqueFd sigfd(signalfd(-1, &signals, SFD_CLOEXEC));
   if (!sigfd.valid()) {
     // Without it SIGTERM and SIGHUP (blocked above) would never be seen: refuse to run.
