@@ -24,3 +24,19 @@ file(INSTALL DESTINATION ${_units} TYPE FILE FILES ${_service} ${FUSEDET_SOURCE_
 # The group of socket clients; systemd-sysusers creates it (the package's postinst runs it).
 file(INSTALL DESTINATION ${CMAKE_INSTALL_PREFIX}/lib/sysusers.d TYPE FILE
      FILES ${FUSEDET_SOURCE_DIR}/systemd/fusedet.sysusers RENAME fusedet.conf)
+
+# The manual pages (cmake/FusedetManPages.cmake; none without help2man): the build tree's default
+# config path as the installed fusedetd sees it, gzip -9n as Debian wants them.
+if(FUSEDET_MAN_DIR AND EXISTS ${FUSEDET_MAN_DIR}/fusedetd.1)
+  foreach(_page fusedet.1 fusedetd.1)
+    file(READ ${FUSEDET_MAN_DIR}/${_page} _text)
+    string(REPLACE "${FUSEDET_BINARY_DIR}/etc/" "${_etc}/" _text "${_text}")
+    file(WRITE ${FUSEDET_BINARY_DIR}/man/installed/${_page} "${_text}")
+    execute_process(COMMAND gzip -9n -f ${FUSEDET_BINARY_DIR}/man/installed/${_page} RESULT_VARIABLE _rc)
+    if(NOT _rc EQUAL 0)
+      message(FATAL_ERROR "gzip ${FUSEDET_BINARY_DIR}/man/installed/${_page} failed")
+    endif()
+    file(INSTALL DESTINATION ${CMAKE_INSTALL_PREFIX}/${FUSEDET_MANDIR}/man1 TYPE FILE
+         FILES ${FUSEDET_BINARY_DIR}/man/installed/${_page}.gz)
+  endforeach()
+endif()
