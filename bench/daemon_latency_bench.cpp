@@ -15,6 +15,7 @@
 #include <map>
 #include <thread>
 
+#include "fusedet/boost/vector_path.h"
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/service_parts.h"
@@ -132,6 +133,7 @@ int main(int argc, char** argv) {
               closeOnScan ? "the next scan (--close-on-scan)" : "the tilt sample that proves the turn (default)");
   std::printf("load average (/proc/loadavg 1/5/15 min) at start: %s, at end: %s\n", loadAtStart.c_str(),
               loadAverage().c_str());
+  std::printf("detection's %s\n", boosting::vectorPathSummary().c_str());
   std::printf("stacks: %zu received by the client, %llu dropped by the stack queue (detection behind), %llu unpaired sweeps; "
               "sweeps %llu, closed by a tilt sample %llu\n",
               latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),

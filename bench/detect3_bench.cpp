@@ -12,12 +12,16 @@
 //     layer, the same scale factor 1.1 and minNeighbors 3 (a peer doing comparable work, as a
 //     yardstick for the machine: a ratio to it travels between machines better than milliseconds).
 // Times are the calling thread's CPU time (CLOCK_THREAD_CPUTIME_ID), one thread each unless said,
-// median over the rounds; wall times beside them. Ours runs on its widest vector path (AVX-512
-// where the CPU has it) and, as a second line, on the AVX2 path. The 2-thread run reports wall time (its work is
-// split over two threads) and the scaling against one thread.
+// median over the rounds; wall times beside them. Ours runs on the vector path the dispatch picks
+// (the CPU's widest, narrowed by FUSEDET_SIMD: fusedet/boost/vector_path.h; the CPU's extensions and
+// the path are printed first) and, row by row, on every path the CPU has (AVX-512, AVX2, scalar)
+// within FUSEDET_SIMD, each with its share of time in the integrals (the same on every path), the
+// window scan (the vector stage loops) and the rest (grouping). The 2-thread run reports wall time
+// (its work is split over two threads) and the scaling against one thread.
 //
 // Headline: bench: detect3_ms, bench: detect3_daemon_path_ms (detectPerClass, the path fusedetd runs),
-// bench: opencv_face_ms, bench: detect3_over_opencv_face, bench: detect3_daemon_path_over_opencv_face.
+// bench: opencv_face_ms, bench: detect3_over_opencv_face, bench: detect3_daemon_path_over_opencv_face
+// (all on the dispatched path); per path P (avx512, avx2, scalar): detect3_P_ms, detect3_P_over_opencv_face.
 
 #include <algorithm>
 #include <chrono>
@@ -37,8 +41,11 @@
 
 #include "fusedet/boost/class_detection.h"
 #include "fusedet/boost/grouping.h"
+#include "fusedet/boost/integral_grids.h"
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/multi_detector.h"
+#include "fusedet/boost/vector_path.h"
+#include "fusedet/boost/window_scanner.h"
 #include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/datasets/kitti.h"
 
@@ -145,6 +152,21 @@ int main(int argc, char** argv) try {
               "fusedetd's path (detectPerClass, as fusedetd, demo and detect run): the same pass, grouped %s, the others as above\n",
               a.drive.c_str(), id.c_str(), stack.width(), stack.height(), stack.size(), perClassText.c_str());
   std::printf("load average before: %s (%u cores)\n", loadAverage().c_str(), std::thread::hardware_concurrency());
+  const int dispatched = dispatchedVectorLanes();
+  std::printf("dispatched: %s\n", vectorPathSummary().c_str());
+  // Every path the CPU has within FUSEDET_SIMD, widest first.
+  std::vector<int> paths;
+  for (int lanes : {8, 4, 1}) {
+    setVectorLanesLimit(lanes);
+    if (dispatchedVectorLanes() == lanes) paths.push_back(lanes);
+  }
+  setVectorLanesLimit(8);
+  std::vector<LayerRequest> requests;
+  std::vector<const Cascade*> cascades;
+  for (const Cascade& c : models) {
+    cascades.push_back(&c);
+    for (LayerRequest& r : layerRequests(c)) requests.push_back(std::move(r));
+  }
 
   // Same decisions: the one-pass scanner's raw hits against the previous per-class path's.
   std::vector<ScanStats> stats;
@@ -165,7 +187,8 @@ int main(int argc, char** argv) try {
                 eq ? "identical" : "DIFFERENT");
   }
 
-  Timing ours, ours2, ours4lanes, previous, opencv, daemonPath;
+  Timing ours, ours2, previous, opencv, daemonPath, integrals;
+  std::vector<Timing> pathTotal(paths.size()), pathScan(paths.size());
   std::size_t found = 0, foundPrev = 0, faces = 0, foundDaemonPath = 0;
   for (int r = 0; r < a.rounds; ++r) {
     ours.add([&] { found = detect(all, stack, scan, group).size(); });
@@ -180,9 +203,16 @@ int main(int argc, char** argv) try {
       for (std::size_t i = 0; i < models.size(); ++i)
         foundPrev += groupHits(each[i].scan(integrateFor(models[i], stack), scan), group, models[i].className, stack).size();
     });
-    setVectorLanesLimit(4);  // the AVX2 path, for CPUs without AVX-512
-    ours4lanes.add([&] { (void)detect(all, stack, scan, group); });
-    setVectorLanesLimit(8);
+    integrals.add([&] { (void)IntegralGrids(stack, requests, 1); });
+    {
+      const IntegralGrids grids(stack, requests, 1);
+      for (std::size_t k = 0; k < paths.size(); ++k) {
+        setVectorLanesLimit(paths[k]);
+        pathTotal[k].add([&] { (void)detect(all, stack, scan, group); });
+        pathScan[k].add([&] { (void)scanCascades(cascades, grids, scan, nullptr); });
+      }
+      setVectorLanesLimit(8);
+    }
     ScanParams two = scan;
     two.threads = 2;
     ours2.add([&] { (void)detect(all, stack, two, group); });
@@ -194,8 +224,15 @@ int main(int argc, char** argv) try {
               d3, minimum(ours.cpu), median(ours.wall), found, d3 * 1e6 / double(stumps));
   std::printf("  ours, fusedetd's path, 1 thread:    %8.2f (%7.2f) / %8.2f  -> %zu detections (detectPerClass: car's own grouping)\n", d3k,
               minimum(daemonPath.cpu), median(daemonPath.wall), foundDaemonPath);
-  std::printf("  ours, same, AVX2 path (4 lanes):     %8.2f (%7.2f) / %8.2f\n", median(ours4lanes.cpu),
-              minimum(ours4lanes.cpu), median(ours4lanes.wall));
+  const double integralMs = median(integrals.cpu);
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    const double t = median(pathTotal[k].cpu), sc = std::min(t, median(pathScan[k].cpu));
+    const double in = std::min(t - sc, integralMs);
+    std::printf("  ours, same, %-6s path (%d lane%s): %8.2f (%7.2f) / %8.2f  -> %.3f x OpenCV; integrals %2.0f %%, scan %2.0f %%, "
+                "grouping and the rest %2.0f %%\n",
+                vectorPathName(paths[k]).c_str(), paths[k], paths[k] > 1 ? "s" : " ", t, minimum(pathTotal[k].cpu),
+                median(pathTotal[k].wall), cvf > 0 ? t / cvf : 0.0, 100 * in / t, 100 * sc / t, 100 * (t - sc - in) / t);
+  }
   std::printf("  previous per-class path, 1 thread:  %8.2f (%7.2f) / %8.2f  -> %zu detections\n", prev,
               minimum(previous.cpu), median(previous.wall), foundPrev);
   std::printf("  OpenCV frontalface_default, 1 thr:  %8.2f (%7.2f) / %8.2f  -> %zu faces (intensity layer %dx%d)\n",
@@ -218,7 +255,12 @@ int main(int argc, char** argv) try {
   std::printf("bench: detect3_previous_ms %.3f\n", prev);
   std::printf("bench: detect3_speedup_vs_previous %.3f\n", d3 > 0 ? prev / d3 : 0.0);
   std::printf("bench: detect3_2threads_wall_ms %.3f\n", median(ours2.wall));
-  std::printf("bench: detect3_avx2_ms %.3f\n", median(ours4lanes.cpu));
+  std::printf("bench: detect3_vector_lanes %d\n", dispatched);
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    const std::string name = vectorPathName(paths[k]);
+    std::printf("bench: detect3_%s_ms %.3f\n", name.c_str(), median(pathTotal[k].cpu));
+    std::printf("bench: detect3_%s_over_opencv_face %.3f\n", name.c_str(), cvf > 0 ? median(pathTotal[k].cpu) / cvf : 0.0);
+  }
   std::printf("bench: detect3_ms %.3f\n", d3);
   std::printf("bench: detect3_daemon_path_ms %.3f\n", d3k);
   std::printf("bench: opencv_face_ms %.3f\n", cvf);

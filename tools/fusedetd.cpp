@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "fusedet/boost/vector_path.h"
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/run.h"
 
@@ -21,7 +22,7 @@ int main(int argc, char** argv) {
                  "socket path to bind instead of socket.path (ignored under socket activation)");
   app.add_flag("--check-config", checkOnly,
                "load and validate the configuration, print the effective values, exit 0 if valid");
-  app.set_version_flag("--version", std::string("fusedetd ") + FUSEDET_VERSION);
+  app.set_version_flag("--version", std::string("fusedetd ") + FUSEDET_VERSION + "\n" + fusedet::boosting::vectorPathSummary());
   app.footer(
       "Runs sources (live: the LMS 291 on laser.device, the tilt motor on tilt.interface, the camera\n"
       "on camera.device; replay: the sensor log in replay.file), fusion and every configured class\n"

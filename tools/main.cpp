@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "command.h"
+#include "fusedet/boost/vector_path.h"
 
 namespace fusedet::tools {
 
@@ -59,7 +60,7 @@ int main(int argc, char** argv) {
       "--help. Data paths default to ../shared/data (the KITTI frames beside the checkout).",
       "fusedet"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("fusedet ") + FUSEDET_VERSION);
+  app.set_version_flag("--version", std::string("fusedet ") + FUSEDET_VERSION + "\n" + fusedet::boosting::vectorPathSummary());
   std::string logLevel = "warn";
   app.add_option("--log-level", logLevel, "trace|debug|info|warn|error")->capture_default_str();
 

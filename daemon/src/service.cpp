@@ -7,6 +7,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "fusedet/boost/vector_path.h"
 #include "fusedet/daemon/config_keys.h"
 #include "fusedet/daemon/protocol.h"
 #include "fusedet/daemon/rig.h"
@@ -215,6 +216,7 @@ nlohmann::json Service::status() const {
       {"mode", mode_},
       {"uptime_s", static_cast<double>(now - startedNs_) * 1e-9},
       {"classes", pipeline_->detector()->classes()},
+      {"vector_path", boosting::vectorPathName(boosting::dispatchedVectorLanes())},
       {"sensors", std::move(sensors)},
       {"rates_hz", {{"scans", p.scanRate}, {"tilt", p.tiltRate}, {"frames", p.frameRate}, {"stacks", p.stackRate}}},
       {"pipeline",

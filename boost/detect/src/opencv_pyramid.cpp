@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "opencv_pyramid.h"
 
+#include "fusedet/boost/vector_path.h"
+
 #include "fusedet/boost/opencv_cascade.h"
 
 #include <tbb/blocked_range.h>
@@ -372,17 +374,11 @@ __attribute__((target("avx2"))) void scanRowAvx2(const RowJob& j, RowResult& out
   }
 }
 
-bool cpuHasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
 #endif
-
-std::atomic<bool> gVectorEnabled{true};
 
 void scanRow(const RowJob& j, RowResult& out) {
 #ifdef FUSEDET_HAVE_AVX2_PATH
-  if (!j.m->trees && gVectorEnabled.load(std::memory_order_relaxed) && cpuHasAvx2()) {
+  if (!j.m->trees && dispatchedVectorLanes() >= 4) {
     if (j.step == 1) scanRowAvx2<1>(j, out);
     else scanRowAvx2<2>(j, out);
     return;
@@ -399,15 +395,6 @@ cv::Mat eightBit(const Layer& l) {
 }
 
 }  // namespace
-
-void setVectorScanEnabled(bool enabled) { gVectorEnabled = enabled; }
-bool vectorScanEnabled() { return gVectorEnabled.load(std::memory_order_relaxed); }
-
-namespace {
-std::atomic<int> gVectorLanesLimit{8};
-}  // namespace
-void setVectorLanesLimit(int lanes) { gVectorLanesLimit = lanes; }
-int vectorLanesLimit() { return gVectorLanesLimit.load(std::memory_order_relaxed); }
 
 void integrateCv(const cv::Mat& gray, bool tilted, CvIntegrals& out) {
   const int w = gray.cols, h = gray.rows;

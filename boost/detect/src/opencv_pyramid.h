@@ -17,11 +17,6 @@
 
 namespace fusedet::boosting {
 
-// setVectorScanEnabled()'s process-wide switch; both scanners (this one and window_scanner.h) read it.
-bool vectorScanEnabled();
-// setVectorLanesLimit()'s limit (window_scanner.h's paths: 8 = AVX-512, 4 = AVX2, 1 = scalar).
-int vectorLanesLimit();
-
 std::vector<RawHit> scanOpenCvPyramid(const Cascade& cascade, const LayerStack& stack,
                                       const ScanParams& params, ScanStats* stats);
 

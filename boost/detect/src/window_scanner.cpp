@@ -16,7 +16,7 @@
 #include <tuple>
 
 #include "fusedet/boost/float_cut.h"
-#include "opencv_pyramid.h"
+#include "fusedet/boost/vector_path.h"
 
 // GCC only: the vector copies get their instruction sets from `#pragma GCC target`, which clang
 // (the fuzz build, tests/fuzz) does not apply, so it refuses the intrinsics; clang takes the
@@ -79,9 +79,9 @@ struct GridScale {
   ScaleWindows win;
   std::vector<std::vector<std::int32_t>> colOfs, rowOfs;  // per grid, per position
   // Per grid: 1 or 2 when neighbouring windows' origins are that many values apart along the whole
-  // row (plain or every-other vector loads replace gathers in stage 0); kSpanStride when any eight
-  // neighbours' origins lie within 16 values of the first one's (two loads and a lane permutation
-  // replace a gather with eight lanes; the four-lane path gathers), else 0.
+  // row (plain or every-other vector loads replace lane-by-lane loads in stage 0); kSpanStride when
+  // any eight neighbours' origins lie within 16 values of the first one's (two loads and a lane
+  // permutation with eight lanes; the four-lane path loads lane by lane), else 0.
   std::vector<int> colStride;
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
@@ -300,24 +300,35 @@ struct Lanes {
     const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kCompressPairs[keep].data()));
     return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), idx));
   }
-  // Corner values of the windows, gathered (origins b + o[k]) or, for neighbours whose origins are
-  // `stride` (1 or 2) apart, loaded from the first one's origin b. The same values either way.
-  static Doubles corners(const double* b, Ints o, int stride) {
+  // The windows' origins for corners(): in memory, for scalar loads.
+  struct Index {
+    alignas(16) std::int32_t k[4];
+  };
+  static Index index(Ints o) {
+    Index i;
+    _mm_store_si128(reinterpret_cast<__m128i*>(i.k), o);
+    return i;
+  }
+  // Corner values of the windows, loaded one by one (origins b + o.k[i]) or, for neighbours whose
+  // origins are `stride` (1 or 2) apart, loaded from the first one's origin b. The same values
+  // either way. Scalar loads beat AVX2's gather instructions (measured: bench/README.md).
+  [[gnu::always_inline]] static Doubles corners(const double* b, const Index& o, int stride) {
     if (stride == 1) return _mm256_loadu_pd(b);
     if (stride == 2) {
       const __m256d lo = _mm256_loadu_pd(b), hi = _mm256_loadu_pd(b + 4);  // p0..p3, p4..p7
       return _mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), 0xD8);        // p0 p4 p2 p6 -> p0 p2 p4 p6
     }
-    // The masked form with every lane on: GCC 12 warns about the plain form's undefined source.
-    return _mm256_mask_i32gather_pd(_mm256_setzero_pd(), b, o, _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8);
+    const __m128d lo = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
+    const __m128d hi = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
+    return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
   }
-  static Ints corners(const std::int32_t* b, Ints o, int stride) {
+  [[gnu::always_inline]] static Ints corners(const std::int32_t* b, const Index& o, int stride) {
     if (stride == 1) return loadInts(b);
     if (stride == 2) {
       const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
       return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
     }
-    return _mm_mask_i32gather_epi32(_mm_setzero_si128(), b, o, _mm_set1_epi32(-1), 4);
+    return _mm_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]]);
   }
   static Doubles toDouble(Doubles v) { return v; }
   static Doubles toDouble(Ints v) { return _mm256_cvtepi32_pd(v); }
@@ -369,18 +380,35 @@ struct Lanes {
   }
   static Ints compress(Ints v, int keep) { return _mm256_maskz_compress_epi32(static_cast<__mmask8>(keep), v); }
   static Doubles compress(Doubles v, int keep) { return _mm512_maskz_compress_pd(static_cast<__mmask8>(keep), v); }
-  // As avx2::Lanes::corners; kSpanStride: the eight values lie within 16 of b (o = offsets from b),
-  // picked from two loads by a permutation instead of gathered.
-  static Doubles corners(const double* b, Ints o, int stride) {
+  struct Index {
+    alignas(32) std::int32_t k[8];
+    Ints v;  // the same, for the span mode's permutation
+  };
+  static Index index(Ints o) {
+    Index i;
+    _mm256_store_si256(reinterpret_cast<__m256i*>(i.k), o);
+    i.v = o;
+    return i;
+  }
+  // As avx2::Lanes::corners (eight scalar loads beat AVX-512's gather instructions too, measured:
+  // bench/README.md); kSpanStride: the eight values lie within 16 of b (o = offsets from b),
+  // picked from two loads by a permutation.
+  [[gnu::always_inline]] static Doubles corners(const double* b, const Index& o, int stride) {
     if (stride == 1) return _mm512_loadu_pd(b);
     if (stride == 2)
       return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14),
                                     _mm512_loadu_pd(b + 8));
     if (stride == kSpanStride)
-      return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_cvtepi32_epi64(o), _mm512_loadu_pd(b + 8));
-    return _mm512_i32gather_pd(o, b, 8);
+      return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_cvtepi32_epi64(o.v), _mm512_loadu_pd(b + 8));
+    const __m128d a = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
+    const __m128d c = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
+    const __m128d d = _mm_loadh_pd(_mm_load_sd(b + o.k[4]), b + o.k[5]);
+    const __m128d e = _mm_loadh_pd(_mm_load_sd(b + o.k[6]), b + o.k[7]);
+    const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(a), c, 1);
+    const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(d), e, 1);
+    return _mm512_insertf64x4(_mm512_castpd256_pd512(lo), hi, 1);
   }
-  static Ints corners(const std::int32_t* b, Ints o, int stride) {
+  [[gnu::always_inline]] static Ints corners(const std::int32_t* b, const Index& o, int stride) {
     if (stride == 1) return loadInts(b);
     if (stride == 2) {
       const __m512i v = _mm512_loadu_si512(b);
@@ -388,8 +416,8 @@ struct Lanes {
           _mm512_permutexvar_epi32(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), v));
     }
     if (stride == kSpanStride)
-      return _mm512_castsi512_si256(_mm512_permutexvar_epi32(_mm512_castsi256_si512(o), _mm512_loadu_si512(b)));
-    return _mm256_mask_i32gather_epi32(_mm256_setzero_si256(), b, o, _mm256_set1_epi32(-1), 4);
+      return _mm512_castsi512_si256(_mm512_permutexvar_epi32(_mm512_castsi256_si512(o.v), _mm512_loadu_si512(b)));
+    return _mm256_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]], b[o.k[4]], b[o.k[5]], b[o.k[6]], b[o.k[7]]);
   }
   static Doubles toDouble(Doubles v) { return v; }
   static Doubles toDouble(Ints v) { return _mm512_cvtepi32_pd(v); }
@@ -417,15 +445,9 @@ struct Lanes {
 #pragma GCC diagnostic pop
 #pragma GCC pop_options
 
-// Widest path the CPU, the vector switch and the lane limit allow: 8, 4 or 1 lanes.
-int vectorLanes(std::size_t grids) {
-  static const bool avx2 = __builtin_cpu_supports("avx2"), avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
-  if (!vectorScanEnabled() || grids > kMaxVectorGrids) return 1;
-  const int limit = vectorLanesLimit();
-  if (avx512 && limit >= 8) return 8;
-  if (avx2 && limit >= 4) return 4;
-  return 1;
-}
+// The dispatched path (vector_path.h): 8, 4 or 1 lanes; scalar for more grids than the vector
+// loops hold.
+int vectorLanes(std::size_t grids) { return grids > kMaxVectorGrids ? 1 : dispatchedVectorLanes(); }
 #endif
 
 // Stage 0 one window at a time (the reference form): the list of every window, then its first stage.

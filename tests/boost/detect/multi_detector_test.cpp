@@ -15,6 +15,7 @@
 
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/opencv_cascade.h"
+#include "fusedet/boost/vector_path.h"
 #include "fusedet/fusion/datasets/kitti.h"
 
 using namespace fusedet;
@@ -116,6 +117,8 @@ TEST(MultiDetector, ScalarFormEqualsVectorForms) {
       setQuickStumpDecisions(quick);
       for (int lanes : {8, 4}) {
         setVectorLanesLimit(lanes);
+        // The path that runs: this one where the CPU has it, else the CPU's widest below it.
+        EXPECT_EQ(dispatchedVectorLanes(), std::min(lanes, cpuVectorLanes() >= 4 ? cpuVectorLanes() : 1));
         std::vector<ScanStats> b;
         const auto vec = all.scan(s, p, &b);
         for (std::size_t i = 0; i < all.size(); ++i) {

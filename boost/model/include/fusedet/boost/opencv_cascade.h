@@ -32,8 +32,9 @@ Cascade parseOpenCvCascade(std::string_view xml, const std::string& source,
                            const std::string& layer = "intensity");
 
 // Scanning uses an AVX2 path (eight windows per step, the same per-window arithmetic, so the same
-// decisions) when the CPU has AVX2. Tests and benchmarks switch it off (process-wide) to compare
-// with the one-window-at-a-time reference path.
+// decisions) when the CPU has AVX2 (and FUSEDET_SIMD allows it: fusedet/boost/vector_path.h).
+// Tests and benchmarks switch every vector path off (process-wide, this scanner's and the
+// one-pass scanner's) to compare with the one-window-at-a-time reference path.
 void setVectorScanEnabled(bool enabled);
 
 }  // namespace fusedet::boosting
