@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: Apache-2.0
-# Manual pages of the packaged programs (fusedet, fusedetd), made from their --help and --version
-# by Debian's help2man at build time; the date is the Debian changelog's (SOURCE_DATE_EPOCH), so
+# Manual pages of the packaged programs (fusedet, fusedetd), made from their --help and the
+# project version (not --version: its second line names the build machine's vector path) by
+# Debian's help2man at build time; the date is the Debian changelog's (SOURCE_DATE_EPOCH), so
 # the pages are the same on every build. The build tree's default config path in them is replaced
 # by the installed one at install time (cmake/install_system_files.cmake), which also compresses
 # them into <prefix>/share/man/man1. Without help2man (scripts/deps installs it) there are none,
@@ -23,7 +24,7 @@ foreach(_program fusedet fusedetd)
   add_custom_command(OUTPUT ${_page}
                      COMMAND ${CMAKE_COMMAND} -E make_directory ${FUSEDET_MAN_DIR}
                      COMMAND sh -c "SOURCE_DATE_EPOCH=$(dpkg-parsechangelog -STimestamp -l '${_changelog}') \
-exec '${HELP2MAN}' --no-info --no-discard-stderr --section 1 --name '${_what}' --output '${_page}' '$<TARGET_FILE:${_program}>'"
+exec '${HELP2MAN}' --no-info --no-discard-stderr --version-string '${PROJECT_VERSION}' --section 1 --name '${_what}' --output '${_page}' '$<TARGET_FILE:${_program}>'"
                      DEPENDS ${_program} ${_changelog} VERBATIM)
   list(APPEND _pages ${_page})
 endforeach()
