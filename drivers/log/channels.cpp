@@ -76,7 +76,8 @@ const std::string& schemaText(Schema s) {
           R"("shaft_diameter":{"type":"number"},"head_length":{"type":"number"},"head_diameter":{"type":"number"},"color":)" + kColor + "}}},"
           R"("texts":{"type":"array","items":{"type":"object","properties":{)" + pose() + R"(,"billboard":{"type":"boolean"},)"
           R"("font_size":{"type":"number"},"scale_invariant":{"type":"boolean"},"color":)" + kColor + R"(,"text":{"type":"string"}}}},)"
-          R"("cubes":{"type":"array"},"cylinders":{"type":"array"},"lines":{"type":"array"},"triangles":{"type":"array"},"models":{"type":"array"}}}}}})",
+          R"("cubes":{"type":"array","items":{"type":"object","properties":{)" + pose() + R"(,"size":)" + kVec3 + R"(,"color":)" + kColor + "}}},"
+          R"("cylinders":{"type":"array"},"lines":{"type":"array"},"triangles":{"type":"array"},"models":{"type":"array"}}}}}})",
   };
   return texts[static_cast<int>(s)];
 }
@@ -326,15 +327,18 @@ std::vector<std::uint8_t> encode(const SceneUpdateMessage& m) {
       arrows.push_back({{"pose", poseAt(o.position, turnXOnto({o.velocity[0] / speed, o.velocity[1] / speed, o.velocity[2] / speed}))},
                         {"shaft_length", speed * 1.0}, {"shaft_diameter", 0.08}, {"head_length", 0.3}, {"head_diameter", 0.25},
                         {"color", colourOf(o.colour)}});
-    const std::array<double, 3> above{o.position[0], o.position[1], o.position[2] + o.diameter / 2 + 0.3};
+    const bool box = o.boxSize[0] > 0 || o.boxSize[1] > 0 || o.boxSize[2] > 0;
+    const json shape = json::array({{{"pose", poseAt(o.position)},
+                                     {"size", vec3(box ? o.boxSize : std::array<double, 3>{o.diameter, o.diameter, o.diameter})},
+                                     {"color", colourOf(o.colour)}}});
+    const double halfHeight = box ? o.boxSize[2] / 2 : o.diameter / 2;
+    const std::array<double, 3> above{o.position[0], o.position[1], o.position[2] + halfHeight + 0.3};
     entities.push_back({{"timestamp", timestamp(m.stamp)}, {"frame_id", m.frame}, {"id", o.id}, {"lifetime", lifetime},
                         {"frame_locked", false}, {"metadata", metadata}, {"arrows", arrows},
-                        {"spheres", json::array({{{"pose", poseAt(o.position)},
-                                                  {"size", vec3({o.diameter, o.diameter, o.diameter})},
-                                                  {"color", colourOf(o.colour)}}})},
+                        {"spheres", box ? json::array() : shape},
                         {"texts", json::array({{{"pose", poseAt(above)}, {"billboard", true}, {"font_size", 14.0},
                                                 {"scale_invariant", true}, {"color", colourOf(o.colour)}, {"text", o.text}}})},
-                        {"cubes", json::array()}, {"cylinders", json::array()}, {"lines", json::array()},
+                        {"cubes", box ? shape : json::array()}, {"cylinders", json::array()}, {"lines", json::array()},
                         {"triangles", json::array()}, {"models", json::array()}});
   }
   return bytesOf(json{{"deletions", json::array({{{"timestamp", timestamp(m.stamp)}, {"type", kDeleteAll}, {"id", ""}}})},

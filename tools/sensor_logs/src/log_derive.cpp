@@ -7,13 +7,13 @@
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/offline_replay.h"
 #include "fusedet/daemon/rig.h"
+#include "fusedet/daemon/stack_channels.h"
 #include "fusedet/daemon/stack_detector.h"
 #include "fusedet/drivers/log/recorder.h"
 #include "fusedet/drivers/log/replay.h"
 #include "fusedet/fusion/camera_model.h"
 #include "fusedet/fusion/pairing.h"
 #include "fusedet/fusion/sweep_assembler.h"
-#include "fusedet/sensor_logs/track_channels.h"
 
 namespace fusedet::sensor_logs {
 
@@ -22,10 +22,6 @@ namespace mcap = drivers::mcap;
 
 namespace {
 
-constexpr char kBaseFrame[] = "laser_base";  // the sweeps' frame: the nodding unit's fixed base
-constexpr char kLaserFrame[] = "laser";      // the scanner, turned by the tilt
-constexpr char kCameraFrame[] = "camera";
-
 // One derived message, kept until the raw messages around it are written (OUT in time order).
 struct Derived {
   std::int64_t t;
@@ -33,26 +29,6 @@ struct Derived {
   logs::Schema schema;
   std::vector<std::uint8_t> json;
 };
-
-logs::TransformMessage transform(Stamp t, const std::string& parent, const std::string& child, const Eigen::Isometry3d& childInParent) {
-  const Eigen::Quaterniond q(childInParent.linear());
-  const Eigen::Vector3d p = childInParent.translation();
-  return logs::TransformMessage{t, parent, child, {p.x(), p.y(), p.z()}, {q.x(), q.y(), q.z(), q.w()}};
-}
-
-logs::CameraCalibrationMessage calibration(Stamp t, const fusion::CameraModel& c) {
-  logs::CameraCalibrationMessage m;
-  m.stamp = t;
-  m.frame = kCameraFrame;
-  m.width = c.width;
-  m.height = c.height;
-  m.distortionModel = c.distortion.size() > 5 ? "rational_polynomial" : "plumb_bob";
-  m.D = c.distortion;
-  for (int i = 0; i < 9; ++i) m.K[static_cast<std::size_t>(i)] = c.K(i / 3, i % 3);
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) m.P[static_cast<std::size_t>(r * 4 + k)] = c.K(r, k);  // P = [K | 0]
-  return m;
-}
 
 bool isRaw(const std::string& topic) {
   return topic == logs::topic::kLaserRaw || topic == logs::topic::kCan || topic == logs::topic::kCameraRaw ||
@@ -93,12 +69,9 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   const Eigen::Vector3d axis = sweepConfig.tiltAxis.normalized();
   auto takeSweeps = [&] {
     for (fusion::Sweep& s : sweeps.takeSweeps()) {
-      logs::PointCloudMessage cloud{s.end, kBaseFrame, {}};
-      cloud.points.reserve(s.points.size());
-      for (const fusion::SweepPoint& p : s.points) cloud.points.push_back({p.x, p.y, p.z, p.remission});
       ++report.sweeps;
       report.points += s.points.size();
-      keep(s.end, logs::topic::kSweep, logs::Schema::kPointCloud, logs::encode(cloud));
+      keep(s.end, logs::topic::kSweep, logs::Schema::kPointCloud, logs::encode(daemon::sweepCloud(s.end, s.points)));
       if (camera && pairer.pair(s)) ++report.stacks;
     }
   };
@@ -115,16 +88,16 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
     Eigen::Isometry3d laserInBase = Eigen::Isometry3d::Identity();
     laserInBase.linear() = Eigen::AngleAxisd(t.angle, axis).toRotationMatrix();
     laserInBase.translation() = laserInBase.linear() * sweepConfig.tiltAxisOffset;
-    keep(t.stamp, logs::topic::kTransforms, logs::Schema::kFrameTransform, logs::encode(transform(t.stamp, kBaseFrame, kLaserFrame, laserInBase)));
+    keep(t.stamp, logs::topic::kTransforms, logs::Schema::kFrameTransform, logs::encode(daemon::frameTransform(t.stamp, daemon::kBaseFrame, daemon::kLaserFrame, laserInBase)));
     ++report.transforms;
     sweeps.addTilt(t);
   };
   h.frame = [&](const drivers::CameraFrame& f) {
     ++report.frames;
     keep(f.stamp, logs::topic::kTransforms, logs::Schema::kFrameTransform,
-         logs::encode(transform(f.stamp, kBaseFrame, kCameraFrame, laserToCamera.inverse())));
+         logs::encode(daemon::frameTransform(f.stamp, daemon::kBaseFrame, daemon::kCameraFrame, laserToCamera.inverse())));
     ++report.transforms;
-    if (camera) keep(f.stamp, logs::topic::kCameraCalibration, logs::Schema::kCameraCalibration, logs::encode(calibration(f.stamp, *camera)));
+    if (camera) keep(f.stamp, logs::topic::kCameraCalibration, logs::Schema::kCameraCalibration, logs::encode(daemon::cameraCalibration(f.stamp, *camera)));
     pairer.addFrame(f);
   };
   while (replay.step(h)) takeSweeps();
@@ -132,16 +105,12 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   takeSweeps();
   if (camera && !options.models.empty()) {
     const daemon::OfflineReplayReport r = daemon::replayOffline(pipelineConfig, in, in, [&](const daemon::StackResult& stack) {
-      logs::AnnotationsMessage a{stack.frameStamp, {}};
-      for (const daemon::LocatedDetection& ld : stack.detections) {
-        const Detection& d = ld.detection;
-        a.boxes.push_back({d.className, d.score, d.box.x, d.box.y, d.box.w, d.box.h});
-      }
+      const logs::AnnotationsMessage a = daemon::detectionAnnotations(stack);
       report.detections += a.boxes.size();
       keep(stack.frameStamp, logs::topic::kDetections, logs::Schema::kImageAnnotations, logs::encode(a));
-      keep(stack.frameStamp, logs::topic::kTracks, logs::Schema::kTracks, tracksMessage(stack));
+      keep(stack.frameStamp, logs::topic::kTracks, logs::Schema::kTracks, daemon::tracksMessage(stack));
       keep(stack.frameStamp, logs::topic::kTrackScene, logs::Schema::kSceneUpdate,
-           logs::encode(trackScene(stack, pipelineConfig.tracking.maxCoastS)));
+           logs::encode(daemon::trackScene(stack, pipelineConfig.tracking.maxCoastS)));
       report.trackMessages += 2;
     });
     report.stacks = r.counters.stacksDetected;
@@ -153,7 +122,10 @@ DeriveReport deriveLog(const std::filesystem::path& in, const std::filesystem::p
   const mcap::McapReader reader(in);
   for (const mcap::Metadata& m : reader.index().metadata) rec.addMetadata(m.name, m.entries);
   std::string models;
-  for (const auto& m : options.models) models += (models.empty() ? "" : " ") + m.string();
+  for (const auto& m : options.models) {
+    if (!models.empty()) models += ' ';
+    models += m.string();
+  }
   rec.addMetadata("fusedet.derived", {{"from", in.string()}, {"models", models},
                                       {"note", "derived channels computed by fusedet log derive from the raw channels"}});
   std::size_t next = 0;

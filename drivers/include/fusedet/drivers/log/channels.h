@@ -124,7 +124,7 @@ struct SecNsec {
 };
 SecNsec secNsec(Stamp s);
 
-// Objects in 3D for a viewer (foxglove.SceneUpdate): one entity per object, drawn as a sphere with
+// Objects in 3D for a viewer (foxglove.SceneUpdate): one entity per object, drawn as a sphere (or a box) with
 // a text above it and, when it moves, an arrow along its velocity. Every message first deletes
 // every entity the channel drew before (SceneEntityDeletion ALL), so an object absent from a
 // message disappears; each entity also expires after `lifetimeS` (no further message needed).
@@ -136,6 +136,7 @@ struct SceneObject {
   double diameter = 0.5;                        // of the sphere [m]
   std::array<double, 4> colour{1, 1, 1, 1};     // r g b a in [0, 1]
   std::vector<std::pair<std::string, std::string>> metadata;  // key/value pairs a viewer lists
+  std::array<double, 3> boxSize{};              // non-zero: drawn as a box of this size [m] (x y z) instead of a sphere
 };
 struct SceneUpdateMessage {
   Stamp stamp;
@@ -145,7 +146,7 @@ struct SceneUpdateMessage {
 };
 
 // Encoders: the JSON message bytes of each channel (fusedet.Tracks is the daemon's tracks line,
-// fusedet/sensor_logs/track_channels.h).
+// fusedet/daemon/stack_channels.h).
 std::vector<std::uint8_t> encode(const SerialChunk& m);
 std::vector<std::uint8_t> encode(const CanMessage& m);
 std::vector<std::uint8_t> encode(const CameraFrame& m);  // RawImage, or CompressedImage for MJPEG

@@ -11,7 +11,7 @@
 //   /camera/calibration  foxglove.CameraCalibration  with every camera frame
 //   /sweep/points        foxglove.PointCloud         every assembled sweep, frame `laser_base`
 //   /detections          foxglove.ImageAnnotations   per fused stack, stamped like its camera frame
-//   /tracks              fusedet.Tracks              per stack: the socket's tracks line (track_channels.h)
+//   /tracks              fusedet.Tracks              per stack: the socket's tracks line (fusedet/daemon/stack_channels.h)
 //   /tracks/scene        foxglove.SceneUpdate        per stack: one 3D entity per live track
 // The stacks (detections, 3D positions, tracks) are the daemon's pipeline run on IN
 // (fusedet/daemon/offline_replay.h) with the rig's config and the given models: what fusedetd would send.
