@@ -6,6 +6,10 @@
 // socket server - and a socket client measures (receive time - sensor stamp of the stack). Beside
 // it, on the same stacks in the same run: the pipeline's pure compute (fuse + detect), the floor
 // any queueing, sweep closing and socket overhead adds to.
+// --viewers 0,1,5: after that run, the same replay again once per count with the live view on
+// (live.listen on loopback, docs/live-view.md) and that many WebSocket viewers subscribed to
+// every channel and reading as fast as they can (live_viewers.h): the latency table with 0, 1 and
+// 5 viewers beside the run without the live view.
 
 #include <unistd.h>
 
@@ -22,6 +26,7 @@
 #include "fusedet/daemon/stats.h"
 #include "fusedet/daemon/thread_info.h"
 #include "fusedet/fusion/synthesis/synth_log.h"
+#include "live_viewers.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -44,6 +49,78 @@ std::vector<ThreadCpu> since(const std::vector<ThreadCpu>& before, std::vector<T
   return now;
 }
 
+struct Run {
+  std::vector<double> latency, compute, deliver;
+  std::map<std::string, std::vector<double>> stages;  // stages_ms of each detections line
+  std::vector<std::string> perStack;
+  PipelineCounters counters;
+  nlohmann::json status;
+  std::vector<ThreadCpu> threadCpu;
+  double seconds = 0;
+  std::uint64_t viewerMessages = 0, viewerBytes = 0;
+  int viewersDropped = 0;
+};
+
+// One service replaying the log `passes` times, a socket client measuring; viewers >= 0: the
+// live view on with that many viewers.
+Run replay(Config config, int passes, int viewers) {
+  Run run;
+  auto& latency = run.latency;
+  auto& compute = run.compute;
+  auto& deliver = run.deliver;
+  auto& stages = run.stages;
+  auto& perStack = run.perStack;
+  if (viewers >= 0) {
+    config.live.listen = "127.0.0.1:0";
+    config.socket.path += "." + std::to_string(viewers);
+  }
+  ServiceParts parts = replayParts(config, {});
+  parts.listener = bindUnixSocket(config.socket.path);
+  Service service(std::move(parts));
+  Client client(config.socket.path);
+  client.send({{"cmd", "subscribe"}});
+  const std::vector<ThreadCpu> threadsAtStart = processThreadCpu();
+  service.start();
+  std::unique_ptr<fusedet::bench::LiveViewers> live;
+  if (viewers > 0) live = std::make_unique<fusedet::bench::LiveViewers>("127.0.0.1", service.liveServer()->address().port, viewers);
+  const auto t0 = std::chrono::steady_clock::now();
+
+  std::uint64_t lastStack = UINT64_MAX;  // the last stack of the last pass, once fusion has flushed it
+  while (true) {
+    auto line = client.readLine(std::chrono::seconds(30));
+    if (!line) break;
+    const Stamp received = Stamp::now();
+    const auto m = nlohmann::json::parse(*line);
+    if (m["type"] != "detections") continue;
+    latency.push_back(static_cast<double>(received.ns - m["sensor_ns"].get<std::int64_t>()) * 1e-6);
+    compute.push_back(m["fuse_ms"].get<double>() + m["detect_ms"].get<double>());
+    for (const auto& [stage, ms] : m["stages_ms"].items()) stages[stage].push_back(ms.get<double>());
+    deliver.push_back(static_cast<double>(received.ns - m["detected_ns"].get<std::int64_t>()) * 1e-6);
+    char row[200];
+    std::snprintf(row, sizeof row, "  %5llu %9.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %4zu",
+                  static_cast<unsigned long long>(m["stack"].get<std::uint64_t>()), latency.back(),
+                  stages["close"].back(), stages["decode"].back() + stages["fuse"].back(), stages["fuse_cpu"].back(),
+                  stages["queue"].back(), stages["detect"].back(), stages["detect_cpu"].back(), deliver.back(),
+                  m["detections"].size());
+    perStack.push_back(row);
+    const auto pc = service.pipeline().counters();
+    if (lastStack == UINT64_MAX && pc.streamEnds >= static_cast<std::uint64_t>(passes)) lastStack = pc.stacksFused - 1;
+    if (m["stack"].get<std::uint64_t>() >= lastStack) break;
+  }
+  run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (live) {
+    live->stop();
+    run.viewerMessages = live->messages();
+    run.viewerBytes = live->bytes();
+    run.viewersDropped = live->disconnected();
+  }
+  run.counters = service.pipeline().counters();
+  run.status = service.status();
+  run.threadCpu = since(threadsAtStart, processThreadCpu());
+  service.stop(std::chrono::steady_clock::now() + std::chrono::milliseconds(1500));
+  return run;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -52,6 +129,7 @@ int main(int argc, char** argv) {
   int frames = 6, passes = 3, threads = 0;
   double speed = 1.0;
   bool closeOnScan = false;
+  std::vector<int> viewerCounts;
   app.add_option("--data", data, "root of the shared data (the log is made from its kitti/ folder)")->capture_default_str();
   app.add_option("--models", models, "folder with car.json, bike.json, person.json")->capture_default_str();
   app.add_option("--log", log, "replay this sensor log instead of synthesising one");
@@ -62,6 +140,10 @@ int main(int argc, char** argv) {
   app.add_flag("--close-on-scan", closeOnScan,
                "close sweeps on the next stroke's first scan (fusion.close_on_tilt false), the rule before "
                "closing on the tilt sample that proves the turn: the peer for the close stage");
+  app.add_option("--viewers", viewerCounts,
+                 "after the run without the live view, one run per count with the live view on and that many "
+                 "viewers subscribed to every channel, e.g. --viewers 0,1,5")
+      ->delimiter(',');
   CLI11_PARSE(app, argc, argv);
   const std::string loadAtStart = loadAverage();
 
@@ -88,43 +170,18 @@ int main(int argc, char** argv) {
   config.replay.restamp = true;  // stamps = when the sensor would have measured: latencies are real
   config.replay.atEnd = "loop";
   config.fusion.closeOnTilt = !closeOnScan;
-  ServiceParts parts = replayParts(config, {});
-  parts.listener = bindUnixSocket(config.socket.path);
-  Service service(std::move(parts));
-  Client client(config.socket.path);
-  client.send({{"cmd", "subscribe"}});
-  const std::vector<ThreadCpu> threadsAtStart = processThreadCpu();
-  service.start();
-
-  std::vector<double> latency, compute, deliver;
-  std::map<std::string, std::vector<double>> stages;  // stages_ms of each detections line
-  std::vector<std::string> perStack;
-  std::uint64_t lastStack = UINT64_MAX;  // the last stack of the last pass, once fusion has flushed it
-  while (true) {
-    auto line = client.readLine(std::chrono::seconds(30));
-    if (!line) break;
-    const Stamp received = Stamp::now();
-    const auto m = nlohmann::json::parse(*line);
-    if (m["type"] != "detections") continue;
-    latency.push_back(static_cast<double>(received.ns - m["sensor_ns"].get<std::int64_t>()) * 1e-6);
-    compute.push_back(m["fuse_ms"].get<double>() + m["detect_ms"].get<double>());
-    for (const auto& [stage, ms] : m["stages_ms"].items()) stages[stage].push_back(ms.get<double>());
-    deliver.push_back(static_cast<double>(received.ns - m["detected_ns"].get<std::int64_t>()) * 1e-6);
-    char row[200];
-    std::snprintf(row, sizeof row, "  %5llu %9.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %7.1f %4zu",
-                  static_cast<unsigned long long>(m["stack"].get<std::uint64_t>()), latency.back(),
-                  stages["close"].back(), stages["decode"].back() + stages["fuse"].back(), stages["fuse_cpu"].back(),
-                  stages["queue"].back(), stages["detect"].back(), stages["detect_cpu"].back(), deliver.back(),
-                  m["detections"].size());
-    perStack.push_back(row);
-    const auto pc = service.pipeline().counters();
-    if (lastStack == UINT64_MAX && pc.streamEnds >= static_cast<std::uint64_t>(passes)) lastStack = pc.stacksFused - 1;
-    if (m["stack"].get<std::uint64_t>() >= lastStack) break;
-  }
-  const auto c = service.pipeline().counters();
-  const auto status = service.status();
-  const std::vector<ThreadCpu> threadCpu = since(threadsAtStart, processThreadCpu());
-  service.stop(std::chrono::steady_clock::now() + std::chrono::milliseconds(1500));
+  const Run run = replay(config, passes, -1);
+  const std::vector<double>& latency = run.latency;
+  const std::vector<double>& compute = run.compute;
+  const std::vector<double>& deliver = run.deliver;
+  const std::map<std::string, std::vector<double>>& stagesConst = run.stages;
+  std::map<std::string, std::vector<double>> stages = stagesConst;
+  const std::vector<std::string>& perStack = run.perStack;
+  const PipelineCounters& c = run.counters;
+  const nlohmann::json& status = run.status;
+  const std::vector<ThreadCpu>& threadCpu = run.threadCpu;
+  std::vector<std::pair<int, Run>> withViewers;
+  for (int n : viewerCounts) withViewers.emplace_back(n, replay(config, passes, n));
   fs::remove_all(tmp);
 
   std::printf("daemon latency, replay: %s; %d passes at %.2fx recorded speed, re-stamped; classes car bike person, "
@@ -139,6 +196,11 @@ int main(int argc, char** argv) {
               latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),
               static_cast<unsigned long long>(c.unpaired), static_cast<unsigned long long>(c.sweeps.sweeps),
               static_cast<unsigned long long>(c.sweeps.sweepsClosedOnTilt));
+  for (const auto& [n, r] : withViewers)
+    if (r.latency.empty()) {
+      std::fprintf(stderr, "bench_daemon_latency: with %d viewers no stack reached the client: %s\n", n, r.status.dump().c_str());
+      return 1;
+    }
   if (latency.empty()) {
     std::fprintf(stderr, "bench_daemon_latency: no stack reached the client: %s\n", status.dump().c_str());
     return 1;
@@ -171,6 +233,33 @@ int main(int argc, char** argv) {
   std::printf("CPU time per thread during the replay, ms (fd-* = the daemon's threads, fd-tbb = TBB workers helping detection; others: the bench's client):\n");
   for (const ThreadCpu& t : threadCpu)
     if (t.cpuMs > 0) std::printf("  %-16s %9.1f\n", t.name.c_str(), t.cpuMs);
+  if (!withViewers.empty()) {
+    std::printf("live view (every channel subscribed by each viewer; a viewer reads as fast as it can):\n");
+    std::printf("  %-22s %7s %8s %8s %8s %8s %7s %7s %9s %9s %7s %8s\n", "run", "stacks", "p50", "p90", "p99", "max",
+                "q-drop", "skipped", "msgs/s", "MB/s", "v-drop", "live_cpu");
+    auto tableRow = [](const std::string& what, const Run& r) {
+      const nlohmann::json& l = r.status["live"];
+      const double viewersMb = static_cast<double>(r.viewerBytes) / 1e6 / std::max(r.seconds, 1e-9);
+      double liveCpu = 0;
+      for (const ThreadCpu& t : r.threadCpu)
+        if (t.name == "fd-live") liveCpu += t.cpuMs;
+      std::printf("  %-22s %7zu %8.1f %8.1f %8.1f %8.1f %7llu %7llu %9.1f %9.2f %7d %8.0f\n", what.c_str(), r.latency.size(),
+                  percentile(r.latency, 0.5), percentile(r.latency, 0.9), percentile(r.latency, 0.99), percentile(r.latency, 1.0),
+                  static_cast<unsigned long long>(r.counters.stackQueue.dropped),
+                  static_cast<unsigned long long>(l.is_null() ? 0 : l["stacks_skipped"].get<std::uint64_t>()),
+                  static_cast<double>(r.viewerMessages) / std::max(r.seconds, 1e-9), viewersMb, r.viewersDropped, liveCpu);
+    };
+    tableRow("live view off", run);
+    for (const auto& [n, r] : withViewers) tableRow("live on, " + std::to_string(n) + " viewer" + (n == 1 ? "" : "s"), r);
+    std::printf("  (ms: sensor stamp -> socket client; q-drop: stacks the stack queue dropped; skipped: stacks the live "
+                "thread never took (a newer one came first); MB/s: all viewers together; v-drop: viewers disconnected as too slow; "
+                "live_cpu: the fd-live thread's CPU ms)\n");
+    for (const auto& [n, r] : withViewers) {
+      if (r.latency.empty()) continue;
+      std::printf("bench: live_%d_viewers_latency_p50_ms %.1f\n", n, percentile(r.latency, 0.5));
+      std::printf("bench: live_%d_viewers_latency_p99_ms %.1f\n", n, percentile(r.latency, 0.99));
+    }
+  }
   std::printf("bench: compute_p50_ms %.1f\n", percentile(compute, 0.5));
   std::printf("bench: compute_p99_ms %.1f\n", percentile(compute, 0.99));
   std::printf("bench: close_p50_ms %.1f\n", percentile(stages["close"], 0.5));

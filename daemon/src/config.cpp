@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/config_keys.h"
+#include "fusedet/daemon/live/listen_address.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -293,6 +294,21 @@ Config parseTree(const YAML::Node& root, const std::string& source, std::vector<
     s.finish();
   }
   {
+    Section s = top.child("live");
+    s.read("listen", c.live.listen);
+    try {
+      (void)live::parseListenAddress(c.live.listen);
+    } catch (const std::invalid_argument& e) {
+      s.fail(s.at("listen"), std::string("key live.listen: ") + e.what());
+    }
+    s.read("layers", c.live.layers);
+    for (const std::string& name : c.live.layers)
+      if (name.empty()) s.fail(s.at("layers"), "key live.layers: an empty layer name");
+    s.readRange("max_viewers", c.live.maxViewers, 1, 256);
+    s.readRange("viewer_queue_bytes", c.live.viewerQueueBytes, 1 << 20, 1 << 30);
+    s.finish();
+  }
+  {
     Section s = top.child("replay");
     s.read("file", c.replay.file);
     s.read("realtime", c.replay.realtime);
@@ -468,6 +484,12 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "birth_window" << YAML::Value << c.tracking.birthWindow;
   out << YAML::Key << "max_misses" << YAML::Value << c.tracking.maxMisses;
   out << YAML::Key << "max_coast_s" << YAML::Value << c.tracking.maxCoastS << YAML::EndMap;
+  out << YAML::Key << "live" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "listen" << YAML::Value << YAML::DoubleQuoted << c.live.listen;
+  out << YAML::Key << "layers" << YAML::Value;
+  seq(c.live.layers);
+  out << YAML::Key << "max_viewers" << YAML::Value << c.live.maxViewers;
+  out << YAML::Key << "viewer_queue_bytes" << YAML::Value << c.live.viewerQueueBytes << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "file" << YAML::Value << c.replay.file;
   out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime;

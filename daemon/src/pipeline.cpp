@@ -172,6 +172,7 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
   fused.stack.source = "pipeline";
   fused.sweepStart = sweep.start;
   fused.sweepEnd = sweep.end;
+  if (setup_.keepViews) fused.sweep = sweep.points;
   fused.frameStamp = frame.stamp;
   const auto t2 = std::chrono::steady_clock::now();
   fused.fuseMs = std::chrono::duration<double, std::milli>(t2 - t0).count();
@@ -242,6 +243,7 @@ void Pipeline::detectionLoop() {
     track(*result);
     result->stages.trackMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t2).count();
     result->detectedAt = Stamp::now();
+    if (setup_.keepViews) result->view = std::make_shared<const StackView>(StackView{std::move(fused->stack), std::move(fused->sweep)});
     stackRate_.tick(result->detectedAt.ns);
     const std::size_t found = result->detections.size();
     const double detectMs = result->detectMs;

@@ -94,8 +94,17 @@ Service::Service(ServiceParts parts)
       sources_(std::move(parts.sources)) {
   Server::Handlers handlers{[this] { return hello(); }, [this] { return status(); }};
   server_ = std::make_unique<Server>(std::move(parts.listener), serverLimitsFrom(config_), std::move(handlers));
-  pipeline_ = std::make_unique<Pipeline>(pipelineSetup(parts), std::move(parts.detector),
-                                         [this](std::shared_ptr<const StackResult> r) { server_->publish(std::move(r)); });
+  PipelineSetup setup = pipelineSetup(parts);
+  if (const auto address = live::parseListenAddress(config_.live.listen)) {
+    setup.keepViews = true;  // the live view draws the stacks' images and sweeps
+    live::ChannelSettings channels{setup.fuser->projection(), config_.tracking.maxCoastS, config_.live.layers};
+    live::LiveLimits limits{config_.live.maxViewers, static_cast<std::size_t>(config_.live.viewerQueueBytes)};
+    live_ = std::make_unique<live::LiveServer>(*address, limits, live::LiveChannels(std::move(channels)), [this] { return status(); });
+  }
+  pipeline_ = std::make_unique<Pipeline>(std::move(setup), std::move(parts.detector), [this](std::shared_ptr<const StackResult> r) {
+    if (live_) live_->publish(r);
+    server_->publish(std::move(r));
+  });
 }
 
 Service::~Service() { stop(std::chrono::steady_clock::now()); }
@@ -103,6 +112,7 @@ Service::~Service() { stop(std::chrono::steady_clock::now()); }
 void Service::start() {
   startedNs_ = Stamp::now().ns;
   server_->start();
+  if (live_) live_->start();
   pipeline_->start();
   for (auto& s : sources_) s->start(*pipeline_);
   started_ = true;
@@ -118,6 +128,7 @@ std::string Service::stop(std::chrono::steady_clock::time_point deadline) {
   }
   sourcesStopped_ = true;
   pipeline_->stop(deadline);
+  if (live_) live_->stop();
   server_->stop(deadline);
   return problems;
 }
@@ -211,6 +222,27 @@ nlohmann::json Service::status() const {
   nlohmann::json peers = nlohmann::json::array();
   for (const Peer& peer : server_->peers())
     peers.push_back({{"client", peer.client}, {"pid", peer.pid}, {"uid", peer.uid}, {"gid", peer.gid}, {"subscribed", peer.subscribed}});
+  nlohmann::json liveView = nullptr;  // null: live.listen is off
+  if (live_) {
+    const live::LiveCounters l = live_->counters();
+    nlohmann::json encoded = nlohmann::json::object();
+    const auto& channels = live_->channels();
+    for (std::size_t i = 0; i < channels.size() && i < l.encoded.size(); ++i) encoded[channels[i].topic] = l.encoded[i];
+    liveView = {{"listen", live_->address().text()},
+                {"viewers", l.viewers},
+                {"accepted", l.accepted},
+                {"refused", l.refused},
+                {"dropped_slow", l.droppedSlow},
+                {"disconnected", l.disconnected},
+                {"pages", l.pages},
+                {"not_found", l.notFound},
+                {"stacks", l.stacks},
+                {"stacks_skipped", l.stacksSkipped},
+                {"messages", l.messages},
+                {"bytes", l.bytes},
+                {"last_encode_ms", l.lastEncodeMs},
+                {"encoded", std::move(encoded)}};
+  }
   std::lock_guard lock(mutex_);
   return {
       {"mode", mode_},
@@ -248,6 +280,7 @@ nlohmann::json Service::status() const {
         {"refused_not_allowed", s.refusedNotAllowed},
         {"refused_no_fd", s.refusedNoFd},
         {"peers", peers}}},
+      {"live", std::move(liveView)},
       {"reloads", reloads_},
       {"last_reload_error", lastReloadError_}};
 }

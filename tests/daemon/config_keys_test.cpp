@@ -106,6 +106,7 @@ detection: {models: [a.json], scale_factor: 1.2, min_size: [10, 20], max_size: [
             classes: {person: {min_neighbors: 5, laser_extent: false}}}
 tracking: {acceleration_sigma: 1.0, measurement_sigma: 0.3, initial_velocity_sigma: 4.0, gate: 9.0, birth_hits: 3,
            birth_window: 4, max_misses: 2, max_coast_s: 2.0}
+live: {listen: "127.0.0.1:8766", layers: [intensity], max_viewers: 2, viewer_queue_bytes: 1048576}
 replay: {file: x.mcap, realtime: false, speed: 2.0, restamp: false, at_end: exit}
 )";
 }

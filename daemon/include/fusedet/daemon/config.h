@@ -107,6 +107,14 @@ struct Config {
   // The tracker after detection (section `tracking`); its defaults are the library's.
   tracking::TrackerParams tracking;
 
+  // The live view (daemon/live/, docs/live-view.md): Foxglove WebSocket protocol and a page.
+  struct Live {
+    std::string listen;  // "" = off; "PORT" (loopback), "HOST:PORT", "unix:/PATH" (live/listen_address.h)
+    std::vector<std::string> layers{"distance", "remission"};  // fused layers sent as images
+    int maxViewers = 8;                 // further connections are refused (HTTP 503)
+    int viewerQueueBytes = 16 << 20;    // bytes queued for one viewer; a viewer further behind is dropped
+  } live;
+
   struct Replay {
     std::string file;         // MCAP sensor log; non-empty = replay mode (relative: to the config's folder)
     bool realtime = true;     // paced like the recording; false = as fast as possible, nothing dropped

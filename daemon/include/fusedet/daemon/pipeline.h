@@ -54,6 +54,14 @@ struct StageTimes {
   double trackMs = 0;      // the tracker's update (tracking::Tracker)
 };
 
+// What a viewer draws of one stack (the live view, daemon/live/): the fused layers (the
+// undistorted camera image as red, green, blue; the laser layers) and the sweep's points in its
+// own frame (laser_base). Kept only with PipelineSetup::keepViews.
+struct StackView {
+  LayerStack layers;
+  std::vector<fusion::SweepPoint> sweep;
+};
+
 // Everything the detection thread found in one stack.
 struct StackResult {
   std::uint64_t stackId = 0;
@@ -66,6 +74,7 @@ struct StackResult {
   std::vector<LocatedDetection> detections;
   // Every live track after this stack (tentative, confirmed, coasting), ascending id.
   std::vector<tracking::TrackState> tracks;
+  std::shared_ptr<const StackView> view;  // with PipelineSetup::keepViews, else empty
 };
 
 struct PipelineSetup {
@@ -80,6 +89,9 @@ struct PipelineSetup {
   // sources that can wait too (a log replayed as fast as possible), never for live devices.
   bool lossless = false;
   tracking::TrackerParams tracking;  // the tracker after detection (config `tracking`)
+  // Each result carries its layers and sweep (StackResult::view) for the live view: the layers
+  // are handed over after detection (no copy), the sweep's points are copied once.
+  bool keepViews = false;
 };
 
 struct PipelineCounters {
@@ -144,6 +156,7 @@ class Pipeline : public SensorSink {
   static std::size_t bytesOf(const SensorMessage& message);
   struct FusedStack {
     LayerStack stack;
+    std::vector<fusion::SweepPoint> sweep;  // with setup_.keepViews
     Stamp sweepStart, sweepEnd, frameStamp;
     double fuseMs = 0;
     StageTimes stages;

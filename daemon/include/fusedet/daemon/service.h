@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fusedet/daemon/config.h"
+#include "fusedet/daemon/live/live_server.h"
 #include "fusedet/daemon/pipeline.h"
 #include "fusedet/daemon/server.h"
 #include "fusedet/daemon/source.h"
@@ -63,7 +64,7 @@ class Service {
   Service(const Service&) = delete;
   Service& operator=(const Service&) = delete;
 
-  // Starts the server, the pipeline threads and the sources: afterwards requests are served.
+  // Starts the server, the live view, the pipeline threads and the sources: afterwards requests are served.
   void start();
   // Stops the sources (each takes up to its Source::stopTime(): a tilt motor is brought to rest
   // first), drains the pipeline and flushes clients, all by `deadline` when that is at least
@@ -102,6 +103,8 @@ class Service {
 
   Pipeline& pipeline() { return *pipeline_; }
   Server& server() { return *server_; }
+  // The live view (config live.listen); nullptr when off.
+  live::LiveServer* liveServer() { return live_.get(); }
   Config config() const;
 
  private:
@@ -114,6 +117,7 @@ class Service {
   std::uint64_t reloads_ = 0;
   std::vector<std::unique_ptr<Source>> sources_;
   std::unique_ptr<Server> server_;
+  std::unique_ptr<live::LiveServer> live_;
   std::unique_ptr<Pipeline> pipeline_;
   std::int64_t startedNs_ = 0;
   bool started_ = false;
