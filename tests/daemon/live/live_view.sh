@@ -17,19 +17,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work"
 mkdir -p "$cache" "$work"
 cache=$(cd "$cache" && pwd) work=$(cd "$work" && pwd) models=$(cd "$models" && pwd)
-packages=(@foxglove/ws-protocol ws @foxglove/schemas ajv puppeteer-core)
-(
-  flock 9
-  for p in "${packages[@]}"; do
-    if [[ ! -f $cache/node_modules/$p/package.json ]]; then
-      (cd "$cache" && npm install --prefix "$cache" --no-audit --no-fund --silent "${packages[@]}")
-      break
-    fi
-  done
-) 9> "$cache/.lock"
-version() { node -p "require('$cache/node_modules/$1/package.json').version"; }
-echo "@foxglove/ws-protocol $(version @foxglove/ws-protocol), ws $(version ws), @foxglove/schemas $(version @foxglove/schemas)," \
-     "ajv $(version ajv), puppeteer-core $(version puppeteer-core), node $(node --version)"
+echo "$("$here/../../npm_tools.sh" "$cache" @foxglove/ws-protocol ws @foxglove/schemas ajv puppeteer-core), node $(node --version)"
 
 synth=(--procedural --frames 4)
 [[ $scene == kitti && -d $data/kitti/velodyne ]] && synth=(--kitti "$data/kitti" --frames 6)

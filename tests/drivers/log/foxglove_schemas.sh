@@ -14,18 +14,7 @@ fusedet=$1 writer=$2 models=$3 data=$4 cache=$5 work=$6
 here=$(cd "$(dirname "$0")" && pwd)
 mkdir -p "$cache" "$work"
 cache=$(cd "$cache" && pwd) work=$(cd "$work" && pwd)
-packages=(@foxglove/schemas ajv @mcap/core fzstd)
-(
-  flock 9
-  for p in "${packages[@]}"; do
-    if [[ ! -f $cache/node_modules/$p/package.json ]]; then
-      (cd "$cache" && npm install --prefix "$cache" --no-audit --no-fund --silent "${packages[@]}")
-      break
-    fi
-  done
-) 9> "$cache/.lock"
-version() { node -p "require('$cache/node_modules/$1/package.json').version"; }
-echo "@foxglove/schemas $(version @foxglove/schemas), ajv $(version ajv), @mcap/core $(version @mcap/core), node $(node --version)"
+echo "$("$here/../../npm_tools.sh" "$cache" @foxglove/schemas ajv @mcap/core fzstd), node $(node --version)"
 "$writer" "$work/sample.mcap" > /dev/null
 node "$here/foxglove_schemas.cjs" "$cache" "$work/sample.mcap" --schemas-only | grep -v '^count '
 scene=(--procedural --frames 2)
