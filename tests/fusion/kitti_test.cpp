@@ -70,6 +70,27 @@ TEST(Kitti, BadFilesNameTheFileAndProblem) {
   EXPECT_THROW((void)readKittiFrame(kKitti, "999999"), std::runtime_error);
 }
 
+// Issue 37: every corner below is finite, but right - left (or bottom - top) overflows to inf; the
+// label was accepted with an infinite width or height (and an IoU with it is NaN).
+TEST(Kitti, LabelBoxesWhoseSizeIsNotFiniteAreRefused) {
+  for (const char* line : {"Car 0 0 0 -1e308 20 1e308 60 0 0 0 0 0 0 0", "Car 0 0 0 10 -1.7e308 30 1.7e308 0 0 0 0 0 0 0"}) {
+    const auto p = writeTemp("huge_labels.txt", std::string("Car 0 0 0 1 2 3 4 0 0 0 0 0 0 0\n") + line + "\n");
+    try {
+      (void)readKittiLabels(p);
+      ADD_FAILURE() << "accepted: " << line;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string() + ": line 2: box has a negative or non-finite size"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  // Large but finite sizes stay boxes.
+  const auto p = writeTemp("large_labels.txt", "Car 0 0 0 -1e300 0 1e300 1e300 0 0 0 0 0 0 0\n");
+  const auto labels = readKittiLabels(p);
+  ASSERT_EQ(labels.size(), 1u);
+  EXPECT_EQ(labels[0].box, (fusedet::Box{-1e300, 0, 2e300, 1e300}));
+}
+
 // Found writing the fuzz corpus (issue 37, tests/fuzz/corpus/kitti_text/calib_tiny_focal.txt): a
 // P2 with a focal length of 1e-300 passes the K [I | t] form check, and K^-1 P2(:, 3) overflows
 // to inf: every projected point would have been inf or NaN. It is refused now; a sane K is not.

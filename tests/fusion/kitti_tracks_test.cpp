@@ -43,7 +43,9 @@ TEST(KittiTracks, LabelsFindTheirTrackByClassAndBox) {
 
 TEST(KittiTracks, MalformedLinesAreNamedNotGuessed) {
   for (const char* bad : {"0 1 Car", "x 1 Car 0 0 0 1 2 3 4", "0 1 Car 0 0 0 5 5 1 1", "-1 1 Car 0 0 0 1 2 3 4",
-                          "0 -2 Car 0 0 0 1 2 3 4", "0 1 Car 0 0 0 nan 2 3 4", "\x01\x02\x03"}) {
+                          "0 -2 Car 0 0 0 1 2 3 4", "0 1 Car 0 0 0 nan 2 3 4", "\x01\x02\x03",
+                          // finite corners whose width (or height) overflows to inf (issue 37)
+                          "0 1 Car 0 0 0 -1e308 2 1e308 4", "0 1 Car 0 0 0 1 -1.7e308 3 1.7e308"}) {
     try {
       parseKittiTracks(std::string(bad) + "\n", "t.txt");
       ADD_FAILURE() << "accepted: " << bad;

@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 #include <stdexcept>
+
+#include "fusedet/fusion/datasets/kitti_box.h"
 
 namespace fusedet::fusion {
 namespace fs = std::filesystem;
@@ -115,9 +118,9 @@ Labels readKittiLabels(const fs::path& file, const KittiClassMap& map) {
     double alpha = 0, x1 = 0, y1 = 0, x2 = 0, y2 = 0;
     if (!(f >> l.sourceClass >> l.truncation >> l.occlusion >> alpha >> x1 >> y1 >> x2 >> y2))
       fail(file, "line " + std::to_string(lineNo) + ": expected class, truncated, occluded, alpha, bbox");
-    if (!(x2 >= x1 && y2 >= y1))
-      fail(file, "line " + std::to_string(lineNo) + ": box has negative size");
-    l.box = Box{x1, y1, x2 - x1, y2 - y1};
+    const std::optional<Box> box = kittiBox(x1, y1, x2, y2);
+    if (!box) fail(file, "line " + std::to_string(lineNo) + ": box has a negative or non-finite size");
+    l.box = *box;
     l.ignore = true;
     l.className = l.sourceClass;
     for (const auto& [src, dst] : map.entries) {

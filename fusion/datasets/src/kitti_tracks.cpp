@@ -3,8 +3,11 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
+
+#include "fusedet/fusion/datasets/kitti_box.h"
 
 namespace fusedet::fusion {
 namespace fs = std::filesystem;
@@ -40,14 +43,14 @@ KittiTracks parseKittiTracks(const std::string& text, const std::string& source)
     int frame = 0, occluded = 0;
     double truncated = 0, alpha = 0, x1 = 0, y1 = 0, x2 = 0, y2 = 0;
     KittiTrackedBox t;
-    if (!(f >> frame >> t.trackId >> t.type >> truncated >> occluded >> alpha >> x1 >> y1 >> x2 >> y2) ||
-        !std::isfinite(x1) || !std::isfinite(y1) || !std::isfinite(x2) || !std::isfinite(y2))
+    if (!(f >> frame >> t.trackId >> t.type >> truncated >> occluded >> alpha >> x1 >> y1 >> x2 >> y2))
       throw std::runtime_error(source + ": line " + std::to_string(lineNo) +
                                ": expected frame, track id, class, truncated, occluded, alpha, bbox");
-    if (frame < 0 || t.trackId < -1 || x2 < x1 || y2 < y1)
+    const std::optional<Box> box = kittiBox(x1, y1, x2, y2);
+    if (frame < 0 || t.trackId < -1 || !box)
       throw std::runtime_error(source + ": line " + std::to_string(lineNo) +
-                               ": negative frame, track id below -1 or box of negative size");
-    t.box = Box{x1, y1, x2 - x1, y2 - y1};
+                               ": negative frame, track id below -1 or box of negative or non-finite size");
+    t.box = *box;
     tracks.frames[frame].push_back(std::move(t));
   }
   return tracks;
