@@ -10,6 +10,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/resource.h>
 #include <sys/socket.h>
 #include <sys/un.h>
 #include <sys/syscall.h>
@@ -26,6 +27,7 @@
 #include <thread>
 
 #include "fusedet/daemon/client.h"
+#include "fusedet/daemon/run.h"
 #include "replay_logs.h"
 
 extern char** environ;
@@ -363,6 +365,36 @@ TEST(Fusedetd, StartupErrorsAreClearAndExit1) {
   EXPECT_NE(readFile(dir / "log2").find("replay.file " + (dir / "garbage.mcap").string()), std::string::npos)
       << readFile(dir / "log2");
   EXPECT_FALSE(fs::exists(dir / "b.sock"));
+}
+
+// Issue 37: signalfd's result was not checked; without it SIGTERM and SIGHUP (blocked for the
+// signalfd) would never be seen. A child process with no descriptor left calls runDaemon: it must
+// refuse to run (exit 1) and say why, before reading any config.
+TEST(Fusedetd, WithoutASignalfdItRefusesToRunAndSaysWhy) {
+  int out[2];
+  ASSERT_EQ(::pipe(out), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    ::dup2(out[1], STDERR_FILENO);
+    const rlimit few{64, 64};
+    if (::setrlimit(RLIMIT_NOFILE, &few) != 0) ::_exit(90);
+    while (::dup(STDIN_FILENO) >= 0) {
+    }
+    if (errno != EMFILE) ::_exit(91);
+    ::_exit(runDaemon(RunOptions{fs::temp_directory_path() / "no-such-config.yaml", ""}));
+  }
+  ::close(out[1]);
+  std::string log;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(out[0], buf, sizeof buf)) > 0;) log.append(buf, static_cast<std::size_t>(n));
+  ::close(out[0]);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status)) << log;
+  EXPECT_EQ(WEXITSTATUS(status), 1) << log;
+  EXPECT_NE(log.find("signalfd: Too many open files (SIGTERM/SIGHUP could not be handled)"), std::string::npos) << log;
+  EXPECT_EQ(log.find("no-such-config.yaml"), std::string::npos) << log;
 }
 
 // Issue 37: `--check-config` on a file with a YAML complex key aborted (uncaught

@@ -211,6 +211,27 @@ TEST(Mcap, ChunkClosesOnLogTimeSpan) {
   EXPECT_TRUE(r.index().intact());
 }
 
+// Issue 37: fdatasync's result was not checked, so a chunk that never reached the disk counted as
+// safe. /dev/null takes every write but has no fsync (the kernel answers EINVAL): the writer must
+// say so at the first chunk it closes.
+TEST(Mcap, AFailedFdatasyncIsAWriteError) {
+  WriterOptions o;
+  o.fsyncChunks = true;
+  McapWriter w("/dev/null", o);
+  const auto c = w.addChannel(0, "/x", "json");
+  w.write(c, 1, 0, payload(0, 0));
+  try {
+    w.flush();
+    FAIL() << "a chunk whose fdatasync failed was reported written";
+  } catch (const McapError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/null: fdatasync: Invalid argument"), std::string::npos) << e.what();
+  }
+  o.fsyncChunks = false;  // the same writes without fdatasync succeed: it was fdatasync that failed
+  McapWriter plain("/dev/null", o);
+  plain.write(plain.addChannel(0, "/x", "json"), 1, 0, payload(0, 0));
+  EXPECT_NO_THROW(plain.flush());
+}
+
 TEST(Mcap, NotMcapIsAnError) {
   const fs::path p = tempFile("text.mcap");
   writeBytes(p, std::vector<std::uint8_t>{'h', 'e', 'l', 'l', 'o', ' ', 'w', 'o', 'r', 'l', 'd'});
