@@ -263,6 +263,14 @@ TEST(LabelExchange, RefusalsNameTheFileAndTheField) {
                   {}, "b.xml");
             }).find("b.xml: image 'x.png' box 'car': xbr=\"nan\" is not a finite number"),
             std::string::npos);
+  // Issue 37: finite corners whose width overflows to inf were accepted.
+  EXPECT_NE(errorOf([&] {
+              imagesFromCvat(
+                  "<annotations><image name='x.png' width='64' height='48'><box label='car' xtl='-1e308' "
+                  "ytl='2' xbr='1e308' ybr='4'/></image></annotations>",
+                  {}, "b.xml");
+            }).find("b.xml: image 'x.png' box 'car': xbr/ybr lie before xtl/ytl or the size is not finite"),
+            std::string::npos);
   EXPECT_NE(errorOf([&] {
               imagesFromCvat("<annotations><track id='0' label='car'/></annotations>", {}, "b.xml");
             }).find("CVAT for video"),

@@ -7,8 +7,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <set>
 #include <stdexcept>
+
+#include "fusedet/fusion/datasets/box_corners.h"
 
 namespace fusedet::fusion {
 
@@ -146,8 +149,9 @@ CvatLabels imagesFromCvat(const std::string& xml, const LabelClassTable& table, 
                    ytl = attributeNumber(file, shape, "ytl", boxWhere);
       const double xbr = attributeNumber(file, shape, "xbr", boxWhere),
                    ybr = attributeNumber(file, shape, "ybr", boxWhere);
-      if (xbr < xtl || ybr < ytl) fail(file, boxWhere + ": xbr/ybr lie before xtl/ytl");
-      l.box = Box{xtl, ytl, xbr - xtl, ybr - ytl};
+      const std::optional<Box> box = boxFromCorners(xtl, ytl, xbr, ybr);
+      if (!box) fail(file, boxWhere + ": xbr/ybr lie before xtl/ytl or the size is not finite");
+      l.box = *box;
       // CVAT marks boxes a model drew "auto"; one a person drew or corrected is "manual"/"semi-auto".
       if (const char* source = shape->Attribute("source")) l.origin = std::string(source) == "auto" ? "teacher" : "human";
       if (const char* occluded = shape->Attribute("occluded"))

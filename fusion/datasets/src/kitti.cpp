@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fusedet/fusion/datasets/kitti_box.h"
+#include "fusedet/fusion/datasets/box_corners.h"
 
 namespace fusedet::fusion {
 namespace fs = std::filesystem;
@@ -118,7 +118,7 @@ Labels readKittiLabels(const fs::path& file, const KittiClassMap& map) {
     double alpha = 0, x1 = 0, y1 = 0, x2 = 0, y2 = 0;
     if (!(f >> l.sourceClass >> l.truncation >> l.occlusion >> alpha >> x1 >> y1 >> x2 >> y2))
       fail(file, "line " + std::to_string(lineNo) + ": expected class, truncated, occluded, alpha, bbox");
-    const std::optional<Box> box = kittiBox(x1, y1, x2, y2);
+    const std::optional<Box> box = boxFromCorners(x1, y1, x2, y2);
     if (!box) fail(file, "line " + std::to_string(lineNo) + ": box has a negative or non-finite size");
     l.box = *box;
     l.ignore = true;

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "fusedet/fusion/datasets/kitti_box.h"
+#include "fusedet/fusion/datasets/box_corners.h"
 
 namespace fusedet::fusion {
 namespace fs = std::filesystem;
@@ -46,7 +46,7 @@ KittiTracks parseKittiTracks(const std::string& text, const std::string& source)
     if (!(f >> frame >> t.trackId >> t.type >> truncated >> occluded >> alpha >> x1 >> y1 >> x2 >> y2))
       throw std::runtime_error(source + ": line " + std::to_string(lineNo) +
                                ": expected frame, track id, class, truncated, occluded, alpha, bbox");
-    const std::optional<Box> box = kittiBox(x1, y1, x2, y2);
+    const std::optional<Box> box = boxFromCorners(x1, y1, x2, y2);
     if (frame < 0 || t.trackId < -1 || !box)
       throw std::runtime_error(source + ": line " + std::to_string(lineNo) +
                                ": negative frame, track id below -1 or box of negative or non-finite size");

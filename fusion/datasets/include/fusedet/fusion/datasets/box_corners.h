@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #pragma once
-// A KITTI label's 2D box as the object and tracking label files write it: left, top, right,
-// bottom in pixels.
+// A 2D box as label files write it by its corners: left, top, right, bottom in pixels (KITTI
+// object and tracking labels, CVAT's xtl/ytl/xbr/ybr).
 
 #include <optional>
 
@@ -11,6 +11,6 @@ namespace fusedet::fusion {
 
 // The box, or nothing if a corner or the size is not finite or the size is negative. Corners
 // near +-1.8e308 are finite while right - left overflows to inf, so the size is checked too.
-std::optional<Box> kittiBox(double left, double top, double right, double bottom);
+std::optional<Box> boxFromCorners(double left, double top, double right, double bottom);
 
 }  // namespace fusedet::fusion
