@@ -31,6 +31,10 @@ if(FUSEDET_MAN_DIR AND EXISTS ${FUSEDET_MAN_DIR}/fusedetd.1)
   foreach(_page fusedet.1 fusedetd.1)
     file(READ ${FUSEDET_MAN_DIR}/${_page} _text)
     string(REPLACE "${FUSEDET_BINARY_DIR}/etc/" "${_etc}/" _text "${_text}")
+    # help2man writes each '-' as '\-' (roff): a build folder with a '-' in its path, e.g. a clone
+    # in /tmp/fresh-clone.X, appears in that form.
+    string(REPLACE "-" "\\-" _binary_roff "${FUSEDET_BINARY_DIR}")
+    string(REPLACE "${_binary_roff}/etc/" "${_etc}/" _text "${_text}")
     file(WRITE ${FUSEDET_BINARY_DIR}/man/installed/${_page} "${_text}")
     execute_process(COMMAND gzip -9n -f ${FUSEDET_BINARY_DIR}/man/installed/${_page} RESULT_VARIABLE _rc)
     if(NOT _rc EQUAL 0)
