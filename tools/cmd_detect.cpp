@@ -87,9 +87,8 @@ cv::Mat canvasOf(const LayerStack& stack, const cv::Mat& bgr) {
     cv::normalize(m, o, 0, 255, cv::NORM_MINMAX, CV_8U);
     return o;
   };
-  if (stack.has("red") && stack.has("green") && stack.has("blue")) {
-    cv::merge(std::vector<cv::Mat>{eight(stack.at("blue").data), eight(stack.at("green").data), eight(stack.at("red").data)},
-              out);
+  if (fusion::hasCameraImage(stack)) {
+    out = fusion::cameraImage(stack);
   } else if (stack.has("intensity")) {
     cv::cvtColor(eight(stack.at("intensity").data), out, cv::COLOR_GRAY2BGR);
   } else if (stack.size() > 0) {

@@ -28,17 +28,14 @@ bool isNameChar(char c) {
          c == '-';
 }
 
-// Ids become paths: '/'-separated segments of [A-Za-z0-9_.-], none "." or "..", nothing absolute.
+// Ids become paths: '/'-separated segments (isIdSegment), nothing absolute.
 bool validId(const std::string& id) {
   if (id.empty() || id.size() > 200 || id.front() == '/' || id.back() == '/') return false;
   std::size_t start = 0;
   while (start <= id.size()) {
     std::size_t end = id.find('/', start);
     if (end == std::string::npos) end = id.size();
-    const std::string seg = id.substr(start, end - start);
-    if (seg.empty() || seg == "." || seg == "..") return false;
-    for (char c : seg)
-      if (!isNameChar(c) && c != '.') return false;
+    if (!isIdSegment(id.substr(start, end - start))) return false;
     start = end + 1;
   }
   return true;
@@ -164,6 +161,17 @@ DatasetItem itemFromJson(const fs::path& file, const json& j) {
 }
 
 }  // namespace
+
+bool isIdSegment(const std::string& segment) {
+  return !segment.empty() && segment != "." && segment != ".." &&
+         std::all_of(segment.begin(), segment.end(), [](char c) { return isNameChar(c) || c == '.'; });
+}
+
+std::string toIdSegment(std::string name, const std::string& fallback) {
+  for (char& c : name)
+    if (!isNameChar(c) && c != '.') c = '_';
+  return isIdSegment(name) ? name : fallback;
+}
 
 std::vector<DatasetEntry> readDatasetManifest(const fs::path& datasetDir) {
   const fs::path file = datasetDir / kManifest;

@@ -5,6 +5,9 @@
 #include <array>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
 
 namespace fusedet::fusion {
 
@@ -72,6 +75,31 @@ void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& h
   stack.set(Layer{std::string(layer::kBlue), channels[0], {}});
   stack.set(Layer{std::string(layer::kIntensity), gray, {}});
   stack.set(Layer{std::string(layer::kHue), hueDegrees(bgr), hueValidMask(bgr, hueRule)});
+}
+
+namespace {
+
+// Why the stack has no camera image, or empty when it has one.
+std::string cameraImageProblem(const LayerStack& stack) {
+  const Layer* blue = stack.find(layer::kBlue);
+  for (const std::string_view name : {layer::kBlue, layer::kGreen, layer::kRed}) {
+    const Layer* l = stack.find(name);
+    if (!l || l->data.type() != CV_8UC1) return "the stack has no 8-bit '" + std::string(name) + "' layer";
+    if (l->data.size() != blue->data.size()) return "the stack's red, green and blue layers differ in size";
+  }
+  return {};
+}
+
+}  // namespace
+
+bool hasCameraImage(const LayerStack& stack) { return cameraImageProblem(stack).empty(); }
+
+cv::Mat cameraImage(const LayerStack& stack) {
+  if (const std::string problem = cameraImageProblem(stack); !problem.empty())
+    throw std::invalid_argument(problem + ": no camera image");
+  cv::Mat bgr;
+  cv::merge(std::vector<cv::Mat>{stack.at(layer::kBlue).data, stack.at(layer::kGreen).data, stack.at(layer::kRed).data}, bgr);
+  return bgr;
 }
 
 }  // namespace fusedet::fusion

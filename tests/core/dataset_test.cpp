@@ -273,3 +273,18 @@ TEST(Dataset, FuzzedFilesNeverCrashTheReader) {
   EXPECT_EQ(errors + reads, 600);
   fs::remove_all(dir);
 }
+
+TEST(Dataset, IdSegmentsAreFolderNamesAndFileStemsBecomeOne) {
+  for (const char* ok : {"kitti", "drive_0005", "2011-09-26", "a.b", "..a", "Z9"}) EXPECT_TRUE(isIdSegment(ok)) << ok;
+  for (const char* bad : {"", ".", "..", "a/b", "a b", "\xc3\xa9t\xc3\xa9", "a\\b", "x:y"}) EXPECT_FALSE(isIdSegment(bad)) << bad;
+  EXPECT_EQ(toIdSegment("run 3 (robot:7)", "log"), "run_3__robot_7_");
+  EXPECT_EQ(toIdSegment("2026-12-02.front", "log"), "2026-12-02.front");
+  EXPECT_EQ(toIdSegment("", "log"), "log");
+  EXPECT_EQ(toIdSegment("..", "log"), "log");
+  EXPECT_EQ(toIdSegment("/", "log"), "_");
+  // What toIdSegment makes is always an id the data set takes.
+  const fs::path dir = freshDir("idseg");
+  writeDatasetItem(dir, sampleItem(toIdSegment("caf\xc3\xa9 log", "log") + "/000001", "g", 1));
+  EXPECT_EQ(listDataset(dir), std::vector<std::string>{"caf___log/000001"});
+  fs::remove_all(dir);
+}

@@ -6,21 +6,10 @@
 #include <opencv2/objdetect.hpp>
 #include <stdexcept>
 
+#include "fusedet/fusion/camera_layers.h"
+
 namespace fusedet::tools::experiments {
 namespace {
-
-cv::Mat to8u(const Layer& layer) {
-  if (layer.data.depth() == CV_8U) return layer.data;
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(layer.data, &lo, &hi);
-  // Float colour layers are [0, 1] or [0, 255]; 16-bit ones are [0, 65535].
-  double scale = 1;
-  if (layer.data.depth() == CV_16U) scale = 255.0 / 65535.0;
-  else if (hi <= 1.0) scale = 255.0;
-  cv::Mat out;
-  layer.data.convertTo(out, CV_8U, scale);
-  return out;
-}
 
 Detection personBox(const cv::Rect& r, double score, double upscale) {
   Detection d;
@@ -104,11 +93,7 @@ class HaarPeer final : public PersonPeer {
 }  // namespace
 
 cv::Mat stackToBgr(const LayerStack& stack) {
-  const Layer& r = stack.at(layer::kRed);
-  const Layer& g = stack.at(layer::kGreen);
-  const Layer& b = stack.at(layer::kBlue);
-  cv::Mat bgr;
-  cv::merge(std::vector<cv::Mat>{to8u(b), to8u(g), to8u(r)}, bgr);
+  cv::Mat bgr = fusion::cameraImage(stack);
   if (bgr.cols != stack.width() || bgr.rows != stack.height())
     cv::resize(bgr, bgr, cv::Size(stack.width(), stack.height()));
   return bgr;

@@ -15,8 +15,8 @@
 
 namespace fusedet::tools::experiments {
 
-// The camera image of a stack (red, green, blue layers) as 8-bit BGR. Throws naming the missing
-// layer when the stack has no colour layers.
+// The camera image of a stack (fusion::cameraImage) at the stack's reference size, where the peers'
+// boxes are scored. Throws naming the missing layer when the stack has no colour layers.
 cv::Mat stackToBgr(const LayerStack& stack);
 
 class PersonPeer {

@@ -5,6 +5,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "fusedet/fusion/camera_layers.h"
+
 namespace fusedet::daemon::live {
 namespace {
 
@@ -17,14 +19,8 @@ std::vector<std::uint8_t> jpeg(const cv::Mat& image) {
 }  // namespace
 
 std::optional<std::vector<std::uint8_t>> colourJpeg(const LayerStack& stack) {
-  const Layer* r = stack.find(layer::kRed);
-  const Layer* g = stack.find(layer::kGreen);
-  const Layer* b = stack.find(layer::kBlue);
-  if (!r || !g || !b || r->data.type() != CV_8U || g->data.size() != r->data.size() || b->data.size() != r->data.size())
-    return std::nullopt;
-  cv::Mat bgr;
-  cv::merge(std::vector<cv::Mat>{b->data, g->data, r->data}, bgr);
-  return jpeg(bgr);
+  if (!fusion::hasCameraImage(stack)) return std::nullopt;
+  return jpeg(fusion::cameraImage(stack));
 }
 
 std::vector<std::uint8_t> layerJpeg(const Layer& l) {

@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
+#include "fusedet/fusion/camera_layers.h"
+
 namespace fusedet::fusion {
 
 TeacherCounts& TeacherCounts::operator+=(const TeacherCounts& o) {
@@ -14,21 +16,6 @@ TeacherCounts& TeacherCounts::operator+=(const TeacherCounts& o) {
   vetoed += o.vetoed;
   underHuman += o.underHuman;
   return *this;
-}
-
-cv::Mat cameraImage(const LayerStack& stack) {
-  std::vector<cv::Mat> channels;
-  for (const char* name : {"blue", "green", "red"}) {
-    const Layer* l = stack.find(name);
-    if (!l || l->data.depth() != CV_8U)
-      throw std::invalid_argument(std::string("the stack has no 8-bit '") + name + "' layer: a teacher needs the camera image");
-    channels.push_back(l->data);
-  }
-  if (channels[0].size() != channels[1].size() || channels[0].size() != channels[2].size())
-    throw std::invalid_argument("the stack's red, green and blue layers differ in size");
-  cv::Mat bgr;
-  cv::merge(channels, bgr);
-  return bgr;
 }
 
 namespace {

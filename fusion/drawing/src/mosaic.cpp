@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "fusedet/core/hue_distance.h"
+#include "fusedet/fusion/camera_layers.h"
 #include "fusedet/fusion/drawing/box_drawing.h"
 
 namespace fusedet::fusion {
@@ -68,13 +69,7 @@ cv::Mat renderMosaic(const LayerStack& stack, const Labels& labels, const std::v
   const cv::Size tileSize(std::max(1, cvRound(stack.width() * o.scale)), std::max(1, cvRound(stack.height() * o.scale)));
 
   std::vector<std::pair<std::string, cv::Mat>> tiles;  // caption, BGR at layer size
-  const Layer *r = stack.find(layer::kRed), *g = stack.find(layer::kGreen), *b = stack.find(layer::kBlue);
-  if (o.colourTile && r && g && b && r->data.depth() == CV_8U && r->data.size() == g->data.size() &&
-      r->data.size() == b->data.size() && g->data.depth() == CV_8U && b->data.depth() == CV_8U) {
-    cv::Mat bgr;
-    cv::merge(std::vector<cv::Mat>{b->data, g->data, r->data}, bgr);
-    tiles.emplace_back("colour", bgr);
-  }
+  if (o.colourTile && hasCameraImage(stack)) tiles.emplace_back("colour", cameraImage(stack));
   for (const Layer& l : stack.layers()) {
     char caption[160];
     const double validShare = l.hasMask() ? static_cast<double>(cv::countNonZero(l.valid)) / static_cast<double>(l.valid.total()) : 1.0;

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/sensor_logs/dataset_from_log.h"
 
-#include <cctype>
 #include <cstdio>
 #include <functional>
 #include <opencv2/imgcodecs.hpp>
@@ -11,7 +10,7 @@
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/offline_replay.h"
 #include "fusedet/drivers/log/replay.h"
-#include "fusedet/fusion/datasets/teacher_labels.h"
+#include "fusedet/fusion/camera_layers.h"
 
 namespace fusedet::sensor_logs {
 namespace fs = std::filesystem;
@@ -32,13 +31,6 @@ class StackTap : public daemon::StackDetector {
   std::function<void(const LayerStack&)> take_;
 };
 
-// Item id segments are [A-Za-z0-9_.-]: anything else in a file name becomes '_'.
-std::string idSegment(std::string s) {
-  for (char& c : s)
-    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-' && c != '.') c = '_';
-  return s.empty() || s == "." || s == ".." ? "log" : s;
-}
-
 }  // namespace
 
 FromLogReport datasetFromLog(const fs::path& log, const fs::path& out, const FromLogOptions& options) {
@@ -50,7 +42,7 @@ FromLogReport datasetFromLog(const fs::path& log, const fs::path& out, const Fro
   const daemon::Config config = daemon::parseConfig(rig->configYaml, log.string() + ":fusedet.config");
 
   FromLogReport report;
-  report.group = options.group.empty() ? idSegment(log.stem().string()) : options.group;
+  report.group = options.group.empty() ? toIdSegment(log.stem().string(), "log") : options.group;
   std::int64_t lastKeptNs = 0;
   bool keptAny = false;
   std::string error;  // the tap runs on the detection thread: keep its first error for the caller

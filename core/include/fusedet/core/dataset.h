@@ -33,6 +33,13 @@ struct DatasetItem {
   Labels labels;      // boxes in the stack's reference pixels
 };
 
+// Whether `segment` can be one '/'-separated part of an item id, so also a folder name:
+// [A-Za-z0-9_.-]+, neither "." nor "..".
+bool isIdSegment(const std::string& segment);
+// `name` (a file stem, a group) as an id segment: every other character becomes '_'; what is
+// still none ("", ".", "..") becomes `fallback`.
+std::string toIdSegment(std::string name, const std::string& fallback);
+
 struct DatasetEntry {
   std::string id;
   std::string group;

@@ -29,4 +29,11 @@ cv::Mat hueValidMask(const cv::Mat& bgr, const HueMaskRule& rule = {});
 // (core/hue_distance.h) and the reference hue counts only valid ones.
 void addCameraLayers(LayerStack& stack, const cv::Mat& bgr, const HueMaskRule& hueRule = {});
 
+// The camera image back from a stack's red, green and blue layers (the inverse of addCameraLayers
+// for the colour): CV_8UC3 BGR at the layers' size, sharing no memory with them.
+// hasCameraImage: whether the stack has the three as 8-bit layers of one size; cameraImage throws
+// std::invalid_argument naming what is missing when it has not.
+bool hasCameraImage(const LayerStack& stack);
+cv::Mat cameraImage(const LayerStack& stack);
+
 }  // namespace fusedet::fusion

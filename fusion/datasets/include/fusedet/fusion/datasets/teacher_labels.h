@@ -47,10 +47,6 @@ struct TeacherCounts {
   TeacherCounts& operator+=(const TeacherCounts& o);
 };
 
-// The stack's camera image from its red, green and blue layers (8-bit BGR, layer size); throws
-// std::invalid_argument naming the missing layer.
-cv::Mat cameraImage(const LayerStack& stack);
-
 // Share of measured cells of the stack's distance layer inside `box` and in the ring around it
 // (reference pixels); {-1, -1} when the stack has no distance layer.
 struct DepthCoverage {
