@@ -113,8 +113,9 @@ int runExport(const DatasetOptions& o) {
 int runImport(const DatasetOptions& o) {
   checkFormat(o.format);
   fusion::LabelClassTable table;
+  const std::vector<fusion::ExchangeImage> current = fusion::exchangeImages(o.dataset);
   // A class the data set already has maps to itself, so its own exports read back.
-  for (const auto& image : fusion::exchangeImages(o.dataset))
+  for (const auto& image : current)
     for (const Label& l : image.labels)
       if (!l.ignore && !table.lookup(l.className)) table.entries.emplace_back(l.className, l.className);
   for (const std::string& spec : o.maps) table.set(spec);
@@ -138,7 +139,7 @@ int runImport(const DatasetOptions& o) {
   } else {
     images = fusion::readKittiLabelFiles(o.file, table);
   }
-  const auto result = fusion::applyExchangeImages(o.dataset, images, o.allowUnmatched);
+  const auto result = fusion::applyExchangeImages(o.dataset, current, images, o.allowUnmatched);
   for (const std::string& name : result.unmatched)
     std::fprintf(stderr, "dataset import: %s: image '%s' is no item of %s: skipped\n", o.file.c_str(),
                  name.c_str(), o.dataset.c_str());
@@ -209,11 +210,7 @@ std::map<std::string, std::vector<DatasetEntry>> splitParts(const DatasetOptions
 
 int runSplit(const DatasetOptions& o) {
   for (const auto& [group, entries] : splitParts(o)) {
-    const bool safe =
-        !group.empty() && group != "." && group != ".." &&
-        group.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-") ==
-            std::string::npos;
-    if (!safe)
+    if (!isIdSegment(group))
       throw std::runtime_error("group '" + group + "' is no folder name (letters, digits, '_', '-', '.')");
     const fs::path to = o.out / group;
     std::set<std::string> taken = existingIds(to);

@@ -78,15 +78,21 @@ std::vector<ExchangeImage> exchangeImages(const fs::path& datasetDir) {
 
 ApplyLabelsResult applyExchangeImages(const fs::path& datasetDir, const std::vector<ExchangeImage>& images,
                                       bool allowUnmatched) {
-  const std::vector<std::string> ids = listDataset(datasetDir);
+  return applyExchangeImages(datasetDir, exchangeImages(datasetDir), images, allowUnmatched);
+}
+
+ApplyLabelsResult applyExchangeImages(const fs::path& datasetDir, const std::vector<ExchangeImage>& current,
+                                      const std::vector<ExchangeImage>& images, bool allowUnmatched) {
+  std::map<std::string, const ExchangeImage*> items;  // item id -> its labels and reference size
+  for (const ExchangeImage& item : current) items.emplace(itemIdOf(item.name), &item);
   std::multimap<std::string, std::string> byLastSegment;
-  for (const std::string& id : ids) byLastSegment.emplace(id.substr(id.rfind('/') + 1), id);
+  for (const auto& [id, item] : items) byLastSegment.emplace(id.substr(id.rfind('/') + 1), id);
 
   ApplyLabelsResult result;
   std::vector<std::pair<std::string, const ExchangeImage*>> matched;
   for (const ExchangeImage& image : images) {
     std::string id = itemIdOf(image.name);
-    if (std::find(ids.begin(), ids.end(), id) == ids.end()) {
+    if (!items.count(id)) {
       const auto [first, last] = byLastSegment.equal_range(id);
       if (id.find('/') == std::string::npos && first != last && std::next(first) == last) {
         id = first->second;
@@ -108,12 +114,11 @@ ApplyLabelsResult applyExchangeImages(const fs::path& datasetDir, const std::vec
   // Check every size before writing anything, so a wrong file changes no item.
   for (const auto& [id, image] : matched) {
     if (image->width == 0 && image->height == 0) continue;
-    const DatasetItem item = readDatasetItemLabels(datasetDir, id);
-    if (image->width != item.stack.width() || image->height != item.stack.height())
+    const ExchangeImage& item = *items.at(id);
+    if (image->width != item.width || image->height != item.height)
       throw std::runtime_error("image '" + image->name + "' is " + std::to_string(image->width) + "x" +
                                std::to_string(image->height) + " but item '" + id + "' is " +
-                               std::to_string(item.stack.width()) + "x" +
-                               std::to_string(item.stack.height()));
+                               std::to_string(item.width) + "x" + std::to_string(item.height));
   }
   for (const auto& [id, image] : matched) {
     writeDatasetItemLabels(datasetDir, id, image->labels);

@@ -63,5 +63,9 @@ struct ApplyLabelsResult {
 // size differs from the item's reference size throws (boxes would land in the wrong pixels).
 ApplyLabelsResult applyExchangeImages(const std::filesystem::path& datasetDir,
                                       const std::vector<ExchangeImage>& images, bool allowUnmatched = false);
+// The same with the data set's items as exchangeImages(datasetDir) gave them (`current`), for a
+// caller that has read them already: no item's labels are read twice.
+ApplyLabelsResult applyExchangeImages(const std::filesystem::path& datasetDir, const std::vector<ExchangeImage>& current,
+                                      const std::vector<ExchangeImage>& images, bool allowUnmatched);
 
 }  // namespace fusedet::fusion
