@@ -9,6 +9,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "command.h"
@@ -18,6 +19,7 @@
 #include "fusedet/drivers/lms291/scan_stream.h"
 #include "fusedet/drivers/log/candump.h"
 #include "fusedet/drivers/log/recorder.h"
+#include "fusedet/drivers/log/recording_file.h"
 #include "fusedet/drivers/v4l2/frame_stream.h"
 
 namespace fusedet::tools {
@@ -27,7 +29,7 @@ std::atomic<bool> gStop{false};
 extern "C" void onRecordSignal(int) { gStop = true; }
 
 struct RecordOptions {
-  std::string config, out;
+  std::string config, out, outDir;
   double duration = 0;
   bool camera = true;
   bool can = true;
@@ -48,10 +50,12 @@ std::string utcNow() {
   return b;
 }
 
-int run(const RecordOptions& o) {
+int run(RecordOptions o) {
+  if (o.out.empty() && o.outDir.empty()) throw std::runtime_error("give --out FILE or --out-dir DIR");
   const daemon::Config config = daemon::loadConfig(o.config);
   std::signal(SIGINT, onRecordSignal);
   std::signal(SIGTERM, onRecordSignal);
+  if (!o.outDir.empty()) o.out = drivers::logs::createRecordingFile(o.outDir, std::chrono::system_clock::now()).string();
   drivers::logs::Recorder rec(o.out);  // closes a chunk every second: a crash loses at most that
   const std::string cameraYaml = readText(config.camera.calibration);
   if (cameraYaml.empty()) std::fprintf(stderr, "record: camera calibration %s not readable: not stored\n", config.camera.calibration.c_str());
@@ -128,7 +132,11 @@ const bool registered = registerCommand(
     [](CLI::App& app) {
       auto o = std::make_shared<RecordOptions>();
       app.add_option("--config", o->config, "fusedet.yaml with the devices (laser:, camera:, tilt:)")->required();
-      app.add_option("--out", o->out, "the MCAP log to write")->required();
+      auto* out = app.add_option("--out", o->out, "the MCAP log to write");
+      auto* outDir = app.add_option("--out-dir", o->outDir,
+                                    "write a new log fusedet-<UTC start>.mcap in this folder (never an existing file)");
+      out->excludes(outDir);
+      outDir->excludes(out);
       app.add_option("--duration", o->duration, "stop after S seconds (0 = until Ctrl-C / SIGTERM)")->capture_default_str();
       app.add_flag("!--no-camera", o->camera, "do not record the camera");
       app.add_flag("!--no-can", o->can, "do not record the tilt motor's CAN bus");
@@ -143,6 +151,10 @@ const bool registered = registerCommand(
           "Examples:\n"
           "  fusedet record --config /etc/fusedet/fusedet.yaml --out run.mcap --duration 60\n"
           "  fusedet log info run.mcap\n"
+          "  fusedet record --config /etc/fusedet/fusedet.yaml --out-dir /var/lib/fusedet-recordings\n"
+          "With --out-dir every start writes a file of its own, named by the UTC time it started\n"
+          "(fusedet-20261202T071509Z.mcap, then -2, -3 within one second), as the packaged\n"
+          "fusedet-record.service does after each restart.\n"
           "Exit status: 0 when scans were recorded; 1 on errors ('fusedet record: error: ...') or when none came.");
       return [o]() -> int { return run(*o); };
     });
