@@ -50,9 +50,10 @@ service with socket activation and a watchdog.
 .
 The package contains fusedetd, the fusedet command line (device checks,
 training, evaluation, query client), the bundled car, bike and person models
-(trained on KITTI: CC BY-NC-SA 3.0, non-commercial) and the systemd units.
-The units are not enabled on installation: configure the devices in
-/etc/fusedet/fusedet.yaml first.")
+(trained on KITTI: CC BY-NC-SA 3.0, non-commercial) and the systemd units:
+fusedetd with its socket, and fusedet-record to record the sensors into
+/var/lib/fusedet-recordings instead. The units are not enabled on
+installation: configure the devices in /etc/fusedet/fusedet.yaml first.")
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)

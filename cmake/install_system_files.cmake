@@ -12,15 +12,17 @@ else()
   set(_units ${CMAKE_INSTALL_PREFIX}/lib/systemd/system)
 endif()
 
-# The unit template's variables, for this prefix (ExecStart, --config, Documentation=).
+# The unit templates' variables, for this prefix (ExecStart, --config, Documentation=).
 set(CMAKE_INSTALL_FULL_BINDIR ${CMAKE_INSTALL_PREFIX}/${FUSEDET_BINDIR})
 set(CMAKE_INSTALL_FULL_SYSCONFDIR ${_etc})
 set(CMAKE_INSTALL_FULL_DOCDIR ${CMAKE_INSTALL_PREFIX}/${FUSEDET_DOCDIR})
 set(_service ${FUSEDET_BINARY_DIR}/systemd/installed/fusedetd.service)
 configure_file(${FUSEDET_SOURCE_DIR}/systemd/fusedetd.service.in ${_service} @ONLY)
+set(_record ${FUSEDET_BINARY_DIR}/systemd/installed/fusedet-record.service)
+configure_file(${FUSEDET_SOURCE_DIR}/systemd/fusedet-record.service.in ${_record} @ONLY)
 
 file(INSTALL DESTINATION ${_etc}/fusedet TYPE FILE FILES ${FUSEDET_SOURCE_DIR}/config/fusedet.yaml)
-file(INSTALL DESTINATION ${_units} TYPE FILE FILES ${_service} ${FUSEDET_SOURCE_DIR}/systemd/fusedetd.socket)
+file(INSTALL DESTINATION ${_units} TYPE FILE FILES ${_service} ${_record} ${FUSEDET_SOURCE_DIR}/systemd/fusedetd.socket)
 # The group of socket clients; systemd-sysusers creates it (the package's postinst runs it).
 file(INSTALL DESTINATION ${CMAKE_INSTALL_PREFIX}/lib/sysusers.d TYPE FILE
      FILES ${FUSEDET_SOURCE_DIR}/systemd/fusedet.sysusers RENAME fusedet.conf)

@@ -22,6 +22,7 @@ echo "package: $(basename "$deb") ($(stat -c %s "$deb") bytes)"
 contents=$(dpkg-deb -c "$deb" | awk '{print $6}')
 for f in ./usr/bin/fusedet ./usr/bin/fusedetd \
          ./etc/fusedet/fusedet.yaml ./lib/systemd/system/fusedetd.service ./lib/systemd/system/fusedetd.socket \
+         ./lib/systemd/system/fusedet-record.service \
          ./usr/lib/sysusers.d/fusedet.conf ./usr/share/fusedet/models/car.json ./usr/share/fusedet/models/bike.json \
          ./usr/share/fusedet/models/person.json ./usr/share/doc/fusedet/copyright ./usr/share/doc/fusedet/changelog.gz \
          ./usr/share/doc/fusedet/protocol.md ./usr/share/man/man1/fusedet.1.gz ./usr/share/man/man1/fusedetd.1.gz; do
@@ -42,7 +43,10 @@ if grep -v '^[[:space:]]*#' "$tmp/control/postinst" | grep -qE 'deb-systemd-invo
   fail "postinst enables or starts the service on installation"
 fi
 grep -q 'deb-systemd-helper purge' "$tmp/control/postrm" || fail "postrm does not purge the units' state"
-grep -q 'deb-systemd-invoke stop' "$tmp/control/prerm" || fail "prerm does not stop the service"
+grep -q 'deb-systemd-invoke stop fusedet-record.service fusedetd.service fusedetd.socket' "$tmp/control/prerm" ||
+  fail "prerm does not stop the services and the socket"
+grep -q 'rm -rf /var/lib/fusedet-recordings /var/lib/private/fusedet-recordings' "$tmp/control/postrm" ||
+  fail "postrm purge does not remove fusedet-record.service's recordings"
 depends=$(dpkg-deb -f "$deb" Depends)
 for d in libc6 libstdc++6 libopencv-core libsystemd0 libusb-1.0-0 libyaml-cpp 'systemd | systemd-standalone-sysusers'; do
   grep -qF "$d" <<<"$depends" || fail "Depends lacks $d: $depends"
@@ -57,6 +61,11 @@ echo "control: conffiles, maintainer scripts, Depends and Maintainer ($maintaine
 dpkg-deb -x "$deb" "$tmp/root"
 grep -qx 'ExecStart=/usr/bin/fusedetd --config /etc/fusedet/fusedet.yaml' "$tmp/root/lib/systemd/system/fusedetd.service" ||
   fail "ExecStart: $(grep ExecStart "$tmp/root/lib/systemd/system/fusedetd.service")"
+grep -qx 'ExecStart=/usr/bin/fusedet record --config /etc/fusedet/fusedet.yaml --out-dir ${STATE_DIRECTORY}' \
+  "$tmp/root/lib/systemd/system/fusedet-record.service" ||
+  fail "fusedet-record.service ExecStart: $(grep ExecStart "$tmp/root/lib/systemd/system/fusedet-record.service")"
+grep -qx 'StateDirectory=fusedet-recordings' "$tmp/root/lib/systemd/system/fusedet-record.service" ||
+  fail "fusedet-record.service does not write into StateDirectory=fusedet-recordings (postrm purges that)"
 group=$(awk '$1 == "g" {print $2}' "$tmp/root/usr/lib/sysusers.d/fusedet.conf")
 grep -qx "SocketGroup=$group" "$tmp/root/lib/systemd/system/fusedetd.socket" || fail "the socket's group is not the sysusers group '$group'"
 cmp -s "$tmp/root/etc/fusedet/fusedet.yaml" "$src/config/fusedet.yaml" || fail "packaged fusedet.yaml differs from config/fusedet.yaml"

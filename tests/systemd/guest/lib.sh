@@ -20,12 +20,24 @@ wait_until() {
     sleep 0.2
   done
 }
-main_pid() { systemctl show -P MainPID fusedetd.service; }
+main_pid() { systemctl show -P MainPID "${1:-fusedetd.service}"; }
+# try_write PID DIR [UID GID]: writes DIR/st-probe inside PID's mount namespace (the unit's
+# ProtectSystem=, ProtectHome=, PrivateTmp=, StateDirectory= view), as UID:GID without groups when
+# given, else as root; exit status of the write, its error on stdout.
+try_write() {
+  if [ $# -ge 4 ]; then
+    nsenter -t "$1" -m -- setpriv --reuid="$3" --regid="$4" --clear-groups -- sh -c "echo probe > $2/st-probe" 2>&1
+  else
+    nsenter -t "$1" -m -- sh -c "echo probe > $2/st-probe" 2>&1
+  fi
+}
 # The path list a purge must restore (as docs/packaging.md's snapshot): everything under the
-# system's directories but what apt/dpkg, the journal and systemd's own run-time records keep.
+# system's directories but what apt/dpkg, the journal and systemd's own run-time records keep, and
+# /var/lib/private itself (systemd makes it, 0700, for any DynamicUser= unit's StateDirectory=;
+# what the package's unit put in it must be gone).
 snapshot() {
   find /etc /usr /var /opt /srv -xdev 2> /dev/null | grep -Ev \
-    '^/var/(log|cache/(apt|debconf|man|ldconfig)|lib/(dpkg|apt|systemd/(catalog|random-seed|timers|coredump)|dbus)|tmp)(/|$)|^/etc/(ld\.so\.cache|machine-id)$' |
+    '^/var/(log|cache/(apt|debconf|man|ldconfig)|lib/(dpkg|apt|systemd/(catalog|random-seed|timers|coredump)|dbus)|tmp)(/|$)|^/etc/(ld\.so\.cache|machine-id)$|^/var/lib/private$' |
     LC_ALL=C sort
 }
 finish() {
