@@ -125,5 +125,35 @@ TEST(CalibLog, TargetlessCalibrationFromAPerturbedStartReturnsToTheRig) {
   EXPECT_LE(ms[1], 0.05) << "median translation error";
 }
 
+// Held axes (`fusedet calibrate --hold`) stay exactly where the start has them, about the camera's
+// axes as poseDifference measures them, while the others move; their 1-sigma is 0 and they are never
+// called uncertain. A rotation about y and a shift along x make the start wrong on free axes too.
+TEST(CalibLog, HeldAxesStayAtTheStartAndAreNeverUncertain) {
+  const LogCalibrationInput in = loadLogCalibrationInput(proceduralLog().path, 6);
+  const Eigen::Isometry3d truth = proceduralLog().report.rig.laserToCamera;
+  Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+  d.linear() = Eigen::AngleAxisd(M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  d.translation() = Eigen::Vector3d(0.04, 0.0, 0.0);
+  const Eigen::Isometry3d start = d * truth;
+  fusion::TargetlessOptions opt;
+  opt.measure = fusion::AlignmentMeasure::kBoth;
+  opt.pyramidLevels = 2;
+  opt.hold = fusion::parseCalibAxes({"rz,ty", "tz"});
+  const fusion::TargetlessResult r = fusion::calibrateTargetless(in.frames, in.K, start, opt);
+  const Eigen::Matrix<double, 6, 1> moved = fusion::poseDifference(r.laserToCamera, start);
+  const Eigen::Matrix<double, 6, 1> sigma = fusion::sigmaPerAxis(r);
+  for (int a : {2, 4, 5}) {
+    EXPECT_NEAR(moved(a), 0.0, 1e-9) << fusion::calibAxisName(a) << " is held";
+    EXPECT_EQ(sigma(a), 0.0) << fusion::calibAxisName(a);
+  }
+  EXPECT_GT(moved.head<2>().norm() + moved.segment<1>(3).norm(), 1e-4) << "the free axes moved";
+  const fusion::CalibAxes uncertain = fusion::uncertainAxes(r, opt.hold, 1e-9, 1e-9);
+  for (int a = 0; a < 6; ++a)
+    EXPECT_EQ(uncertain[static_cast<std::size_t>(a)], !opt.hold[static_cast<std::size_t>(a)]) << fusion::calibAxisName(a);
+  EXPECT_THROW(fusion::parseCalibAxes({"tx,yaw"}), std::invalid_argument);
+  opt.hold = fusion::parseCalibAxes({"rx,ry,rz,tx,ty,tz"});
+  EXPECT_THROW(fusion::calibrateTargetless(in.frames, in.K, start, opt), std::invalid_argument) << "nothing left to search";
+}
+
 }  // namespace
 }  // namespace fusedet::sensor_logs

@@ -4,19 +4,15 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "fusedet/fusion/calibration/calib_targetless.h"
+
 namespace fusedet::fusion::detail {
 
 PoseSpread jackknifeSpread(const std::vector<Eigen::Isometry3d>& leaveOneOut, const Eigen::Isometry3d& full) {
   const std::size_t n = leaveOneOut.size();
   if (n < 2) throw std::invalid_argument("jackknife needs at least 2 leave-one-out solutions");
   std::vector<Eigen::Matrix<double, 6, 1>> deltas;
-  for (const Eigen::Isometry3d& T : leaveOneOut) {
-    const Eigen::Isometry3d d = T * full.inverse();
-    const Eigen::AngleAxisd aa(d.linear());
-    Eigen::Matrix<double, 6, 1> v;
-    v << aa.axis() * aa.angle() * 180.0 / M_PI, d.translation();
-    deltas.push_back(v);
-  }
+  for (const Eigen::Isometry3d& T : leaveOneOut) deltas.push_back(poseDifference(T, full));
   Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero(), var = Eigen::Matrix<double, 6, 1>::Zero();
   for (const auto& d : deltas) mean += d / static_cast<double>(n);
   for (const auto& d : deltas) var += (d - mean).cwiseAbs2();
