@@ -16,6 +16,7 @@
 #include <random>
 #include <sstream>
 
+#include "calib_starts.h"
 #include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/calibration/calib_kitti.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
@@ -33,18 +34,6 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-// A rotation of angle in [fraction, 1] * maxDeg about a uniformly random axis, and a translation
-// of length in [fraction, 1] * maxT in a uniformly random direction, applied in the camera frame.
-Eigen::Isometry3d perturb(const Eigen::Isometry3d& truth, double maxDeg, double maxT, double fraction, std::mt19937& rng) {
-  std::normal_distribution<double> gauss;
-  std::uniform_real_distribution<double> mag(fraction, 1.0);
-  const Eigen::Vector3d axis = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
-  const Eigen::Vector3d dir = Eigen::Vector3d(gauss(rng), gauss(rng), gauss(rng)).normalized();
-  Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
-  d.linear() = Eigen::AngleAxisd(mag(rng) * maxDeg * M_PI / 180.0, axis).toRotationMatrix();
-  d.translation() = mag(rng) * maxT * dir;
-  return d * truth;
-}
 
 }  // namespace
 
@@ -104,7 +93,7 @@ int main(int argc, char** argv) {
   }
   std::mt19937 rng(seed);
   std::vector<Eigen::Isometry3d> starts;
-  for (int t = 0; t < trials; ++t) starts.push_back(perturb(in.laserToCamera, maxDeg, maxT, fraction, rng));
+  for (int t = 0; t < trials; ++t) starts.push_back(fusedet::bench::perturbedStart(in.laserToCamera, maxDeg, maxT, fraction, rng));
 
   bool pass = true;
   for (const std::string& name : measures) {
