@@ -23,6 +23,7 @@
 #include "fusedet/core/dataset.h"
 #include "fusedet/fusion/camera_layers.h"
 #include "fusedet/fusion/drawing/box_drawing.h"
+#include "network_options.h"
 
 namespace fusedet::tools {
 namespace {
@@ -44,6 +45,7 @@ struct DetectOptions {
   std::string minSize, maxSize;
   double step = 2;
   int threads = 0;
+  NetworkOptions network;
 };
 
 bool isOpenCvXml(const fs::path& p) {
@@ -117,12 +119,19 @@ int runDetect(const DetectOptions& o) {
   } else {
     stack = readStack(o.stack, o.item).stack;
   }
+  // The network's score layers, made by the code import and fusedetd use, from the stack's camera
+  // image (replacing any the stack has): the model then checks that they come from its network.
+  if (const auto neural = o.network.load()) neural->add(stack, bgr.empty() ? fusion::cameraImage(stack) : bgr);
   for (const std::string& l : c.layers) {
     const bool derivable = l == "hue_distance" && stack.has("hue");
     if (!stack.has(l) && !derivable)
       throw std::runtime_error(o.model.string() + " needs layer '" + l + "', which " +
                                (o.image.empty() ? o.stack.string() : o.image.string() + " (an image gives camera layers only)") +
-                               " lacks");
+                               " lacks" +
+                               (isNetworkLayer(l) ? std::string("; give the network that made the model's layers: ") +
+                                                        (c.network.empty() ? std::string("--network ...")
+                                                                           : "--network " + c.network.text())
+                                                  : std::string()));
   }
 
   ScanParams scan;
@@ -198,6 +207,9 @@ const bool registered = registerCommand(
       app.add_option("--json", o->json,
                      "write {\"detections\": [{\"class\", \"score\", \"x\", \"y\", \"w\", \"h\"}, ...]} here "
                      "(reference/image pixels; fusedet show --detections reads it)");
+      addNetworkOptions(app, o->network,
+                        "Needed by a model trained on those layers (its file records the network: the same "
+                        "kind, files and input size, or detection refuses the stack).");
       app.add_option("--draw", o->draw, "write the image (or the stack's colour/intensity layers) with boxes drawn");
       app.add_option("--scale-factor", o->scaleFactor,
                      "window size step between scales, > 1 (default 1.1, as OpenCV's detectMultiScale)");

@@ -8,6 +8,7 @@
 #include "command.h"
 #include "data_dir.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
+#include "network_options.h"
 
 namespace fusedet::tools {
 namespace {
@@ -21,6 +22,7 @@ struct ImportOptions {
   double minDepth = 0.05;
   std::vector<std::string> classMap;
   bool quiet = false;
+  NetworkOptions network;
 };
 
 // "SRC=DST": DST "ignore" (or empty) makes SRC an ignore region.
@@ -49,6 +51,8 @@ int runImport(const ImportOptions& o) {
   options.projection.holeFillRadius = o.holeFill;
   options.projection.minDepth = o.minDepth;
   for (const std::string& spec : o.classMap) applyClassMap(options.classes, spec);
+  options.neural = o.network.load();
+  if (options.neural) std::printf("network %s\n", options.neural->identity().text().c_str());
 
   std::size_t frames = 0, labels = 0;
   for (const auto& root : roots) {
@@ -59,9 +63,11 @@ int runImport(const ImportOptions& o) {
     const auto stats = fusion::importKitti(root, group, o.out, options, [&](const DatasetItem& item) {
       if (!o.quiet) std::printf("  %s: %zu labels\n", item.id.c_str(), item.labels.size());
     });
-    std::printf("%s -> group %s: %zu frames, %zu labels (%zu ignore regions), fusion %.1f ms/frame\n",
-                root.string().c_str(), group.c_str(), stats.frames, stats.labels, stats.ignoreRegions,
-                stats.frames ? stats.fuseMs / static_cast<double>(stats.frames) : 0.0);
+    const double perFrame = stats.frames ? 1.0 / static_cast<double>(stats.frames) : 0.0;
+    std::printf("%s -> group %s: %zu frames, %zu labels (%zu ignore regions), fusion %.1f ms/frame", root.string().c_str(),
+                group.c_str(), stats.frames, stats.labels, stats.ignoreRegions, stats.fuseMs * perFrame);
+    if (options.neural) std::printf(" (network %.1f ms)", stats.neuralMs * perFrame);
+    std::printf("\n");
     frames += stats.frames;
     labels += stats.labels;
   }
@@ -99,14 +105,20 @@ const bool registered = registerCommand(
                      "region; repeatable. Defaults: Car=car Pedestrian=person Cyclist=bike Van=van (kept "
                      "as a hard negative for car); Truck, Tram, Misc, Person_sitting, DontCare = ignore");
       app.add_flag("-q,--quiet", o->quiet, "print only the per-directory summary");
+      addNetworkOptions(app, o->network,
+                        "The items record the network (item.json \"network\"); a cascade trained on its layers "
+                        "needs the same network at detection time.");
       app.footer(
           "Writes one item per frame: red, green, blue, intensity (8-bit) and hue (degrees) at camera\n"
           "resolution; distance (|p_cam| in metres) and remission ([0,1]) with a validity mask at the\n"
-          "laser resolution. Format: docs/dataset-format.md.\n\n"
+          "laser resolution; with --network also neural_person, neural_bicycle, neural_car ([0,1], the\n"
+          "network's best covering anchor score per cell, half the camera resolution). Format:\n"
+          "docs/dataset-format.md.\n\n"
           "Examples:\n"
           "  fusedet import-kitti --out /tmp/kitti-ds                  # all three shared drives\n"
           "  fusedet import-kitti --root ../shared/data/kitti --out ds --class-map Van=ignore\n"
-          "  fusedet import-kitti --root a --root b --out ds --laser-scale 0.25 --hole-fill 3");
+          "  fusedet import-kitti --root a --root b --out ds --laser-scale 0.25 --hole-fill 3\n"
+          "  fusedet import-kitti --out ds --network darknet --networks-dir ../shared/models");
       return [o] { return runImport(*o); };
     });
 

@@ -153,6 +153,13 @@ DatasetItem itemFromJson(const fs::path& file, const json& j) {
   item.stack.stamp = Stamp{getInt(file, j, "stamp_ns", "top level", INT64_MIN, INT64_MAX)};
   item.stack.id = static_cast<std::uint64_t>(getInt(file, j, "stack_id", "top level", 0, INT64_MAX));
   item.stack.source = getString(file, j, "source", "top level");
+  if (j.contains("network")) {
+    try {
+      item.stack.network = parseNetworkRecord(getString(file, j, "network", "top level"));
+    } catch (const std::invalid_argument& e) {
+      fail(file, e.what());
+    }
+  }
   const json& labels = member(file, j, "labels", "top level");
   if (!labels.is_array()) fail(file, "\"labels\" must be an array");
   for (std::size_t i = 0; i < labels.size(); ++i)
@@ -234,10 +241,11 @@ void writeDatasetItem(const fs::path& datasetDir, const DatasetItem& item) {
   }
   json labels = json::array();
   for (const Label& l : item.labels) labels.push_back(labelToJson(l));
-  const json j{{"format", "fusedet-item"}, {"version", kVersion}, {"id", item.id},
+  json j{{"format", "fusedet-item"}, {"version", kVersion}, {"id", item.id},
                {"group", item.group},      {"source", s.source},  {"stack_id", s.id},
                {"stamp_ns", s.stamp.ns},   {"width", s.width()},  {"height", s.height()},
                {"labels", labels},         {"layers", layers}};
+  if (!s.network.empty()) j["network"] = s.network.text();
   const std::string text = j.dump(1) + "\n";
   writeBytesAtomic(dir / kItemFile, text.data(), text.size());
   // A replaced item may have had more layers: drop files the new item.json does not name.
@@ -323,6 +331,7 @@ DatasetItem readDatasetItem(const fs::path& datasetDir, const std::string& id,
     ordered.id = item.stack.id;
     ordered.stamp = item.stack.stamp;
     ordered.source = item.stack.source;
+    ordered.network = item.stack.network;
     for (const std::string& name : wanted)
       if (Layer* l = item.stack.find(name); l && !ordered.has(name)) ordered.set(std::move(*l));
     item.stack = std::move(ordered);

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/config_keys.h"
+#include "fusedet/fusion/neural/network.h"
 #include "fusedet/daemon/live/listen_address.h"
 
 #include <yaml-cpp/yaml.h>
@@ -256,6 +257,24 @@ Config parseTree(const YAML::Node& root, const std::string& source, std::vector<
     s.finish();
   }
   {
+    Section s = top.child("neural");
+    s.read("enabled", c.neural.enabled);
+    s.readOneOf<std::string>("kind", c.neural.kind, {"darknet", "yolov5-onnx"});
+    s.read("files", c.neural.files);
+    s.read("directory", c.neural.directory);
+    s.read("input", c.neural.input);
+    try {
+      const cv::Size in = fusion::parseInputSize(c.neural.input);
+      if (c.neural.kind == "darknet" && (in.width % 32 || in.height % 32))
+        s.fail(s.at("input"), "key neural.input: '" + c.neural.input + "': darknet wants multiples of 32");
+    } catch (const std::invalid_argument& e) {
+      s.fail(s.at("input"), std::string("key neural.input: ") + e.what());
+    }
+    s.readRange("scale", c.neural.scale, 0.05, 1.0);
+    s.readRange("threads", c.neural.threads, 1, 64);
+    s.finish();
+  }
+  {
     Section s = top.child("detection");
     s.read("models", c.detection.models);
     s.readRange("scale_factor", c.detection.scaleFactor, 1.01, 4.0);
@@ -458,6 +477,15 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "max_pair_skew_ms" << YAML::Value << c.fusion.maxPairSkewMs;
   out << YAML::Key << "tilt_window_ms" << YAML::Value << c.fusion.tiltWindowMs;
   out << YAML::Key << "close_on_tilt" << YAML::Value << c.fusion.closeOnTilt << YAML::EndMap;
+  out << YAML::Key << "neural" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "enabled" << YAML::Value << c.neural.enabled;
+  out << YAML::Key << "kind" << YAML::Value << c.neural.kind;
+  out << YAML::Key << "files" << YAML::Value;
+  seq(c.neural.files);
+  out << YAML::Key << "directory" << YAML::Value << c.neural.directory;
+  out << YAML::Key << "input" << YAML::Value << c.neural.input;
+  out << YAML::Key << "scale" << YAML::Value << c.neural.scale;
+  out << YAML::Key << "threads" << YAML::Value << c.neural.threads << YAML::EndMap;
   out << YAML::Key << "detection" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "models" << YAML::Value;
   seq(c.detection.models);

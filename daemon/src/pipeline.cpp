@@ -166,7 +166,9 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
     return;
   }
   const auto t1 = std::chrono::steady_clock::now();
-  fused.stack = setup_.fuser->fuse(bgr.value(), sweep);
+  fusion::FuseTimings fuseTimes;
+  fused.stack = setup_.fuser->fuse(bgr.value(), sweep, &fuseTimes);
+  fused.stages.neuralMs = fuseTimes.neuralMs;
   fused.stack.id = nextStackId_++;
   fused.stack.stamp = frame.stamp;
   fused.stack.source = "pipeline";

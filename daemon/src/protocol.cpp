@@ -114,6 +114,7 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
           {"stages_ms", {{"close", r.stages.closeMs},
                          {"decode", r.stages.decodeMs},
                          {"fuse", r.stages.fuseMs},
+                         {"neural", r.stages.neuralMs},
                          {"fuse_cpu", r.stages.fuseCpuMs},
                          {"queue", r.stages.queueMs},
                          {"detect", r.stages.detectMs},

@@ -30,15 +30,33 @@ const char* tiltMotion(const fusion::SweepStats& s) {
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile) {
   std::filesystem::path calibration = config.camera.calibration;
   if (calibration.is_relative()) calibration = configFile.parent_path() / calibration;
-  return fuserFrom(config, fusion::readCameraModel(calibration));
+  return fuserFrom(config, fusion::readCameraModel(calibration), neuralLayersFrom(config, configFile));
 }
 
-std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera) {
+std::shared_ptr<const fusion::NeuralLayers> neuralLayersFrom(const Config& config, const std::filesystem::path& configFile) {
+  if (!config.neural.enabled) return nullptr;
+  fusion::NeuralLayerOptions o;
+  o.kind = fusion::parseNetworkKind(config.neural.kind);
+  for (const std::string& f : config.neural.files) o.files.emplace_back(f);
+  o.directory = config.neural.directory;
+  if (o.directory.is_relative()) o.directory = configFile.parent_path() / o.directory;
+  o.input = fusion::parseInputSize(config.neural.input);
+  o.scale = config.neural.scale;
+  o.threads = config.neural.threads;
+  try {
+    return std::make_shared<const fusion::NeuralLayers>(o);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("neural (network ") + config.neural.kind + " " + config.neural.input +
+                             "): " + e.what());
+  }
+}
+
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera,
+                                               std::shared_ptr<const fusion::NeuralLayers> neural) {
   fusion::ProjectionConfig projection;
   projection.laserLayerScale = config.fusion.laserLayerScale;
   projection.holeFillRadius = config.fusion.holeFillRadius;
-  return std::make_shared<const fusion::Fuser>(
-      camera, laserToCamera(config), projection);
+  return std::make_shared<const fusion::Fuser>(camera, laserToCamera(config), projection, std::move(neural));
 }
 
 namespace {
@@ -71,8 +89,10 @@ ServerLimits serverLimitsFrom(const Config& config) {
   return l;
 }
 
-std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile) {
-  return std::make_shared<const CascadeSet>(config.detection, configFile.parent_path());
+std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile,
+                                                  const fusion::Fuser& fuser) {
+  return std::make_shared<const CascadeSet>(config.detection, configFile.parent_path(), fuser.stackLayers(),
+                                            fuser.network());
 }
 
 PipelineSetup pipelineSetup(ServiceParts& parts) {
@@ -168,7 +188,7 @@ std::string Service::reload(const Config& next) {
   try {
     applied = withReloaded(config(), next);
     limits = serverLimitsFrom(applied);  // socket.allow_groups may name a group that does not exist
-    detector = detectorFrom(applied, configFile_);
+    detector = detectorFrom(applied, configFile_, pipeline_->fuser());
   } catch (const std::exception& e) {
     std::lock_guard lock(mutex_);
     lastReloadError_ = e.what();

@@ -14,7 +14,7 @@ namespace fusedet::daemon {
 ServiceParts liveParts(Config config, const std::filesystem::path& configFile) {
   ServiceParts parts;
   parts.fuser = fuserFrom(config, configFile);
-  parts.detector = detectorFrom(config, configFile);
+  parts.detector = detectorFrom(config, configFile, *parts.fuser);
   parts.sources.push_back(std::make_unique<Lms291Source>(config));
   parts.sources.push_back(std::make_unique<TiltSource>(config.tilt));
   parts.sources.push_back(std::make_unique<CameraSource>(config.camera));
@@ -46,8 +46,8 @@ ServiceParts replayParts(Config config, const std::filesystem::path& configFile,
   settings.restamp = config.replay.restamp;
   settings.loop = config.replay.atEnd == "loop";
   ServiceParts parts;
-  parts.fuser = fuserFrom(rig.config, rig.camera);
-  if (withModels) parts.detector = detectorFrom(config, configFile);
+  parts.fuser = fuserFrom(rig.config, rig.camera, neuralLayersFrom(config, configFile));
+  if (withModels) parts.detector = detectorFrom(config, configFile, *parts.fuser);
   try {
     parts.sources.push_back(std::make_unique<ReplaySource>(settings));
   } catch (const std::exception& e) {

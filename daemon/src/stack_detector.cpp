@@ -45,7 +45,8 @@ namespace {
 
 // A model trained on layers the daemon's stacks do not have would fail on every stack: refuse it
 // when it is loaded (at start, or at reload, where the old models then keep serving).
-void checkLayers(const boosting::Cascade& cascade, const std::filesystem::path& file, const std::vector<std::string>& stackLayers) {
+void checkLayers(const boosting::Cascade& cascade, const std::filesystem::path& file, const std::vector<std::string>& stackLayers,
+                 const NetworkRecord& network) {
   const auto made = [&](const std::string& name) {
     return std::find(stackLayers.begin(), stackLayers.end(), name) != stackLayers.end();
   };
@@ -58,12 +59,15 @@ void checkLayers(const boosting::Cascade& cascade, const std::filesystem::path& 
                              "', which fusedetd's stacks do not have (" + list +
                              "); train it on those layers (fusedet train --layers)");
   }
+  if (usesNetworkLayers(cascade.layers))
+    requireSameNetwork(cascade.network, file.string() + " (class '" + cascade.className + "')", network,
+                       "fusedetd's network (config section neural)");
 }
 
 }  // namespace
 
 CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem::path& base,
-                       const std::vector<std::string>& stackLayers)
+                       const std::vector<std::string>& stackLayers, const NetworkRecord& network)
     : scan_(scanParamsFrom(settings)),
       group_(groupParamsFrom(settings)),
       extent_(laserExtentFrom(settings)),
@@ -75,7 +79,7 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
     std::filesystem::path file = m;
     if (file.is_relative() && !base.empty()) file = base / file;
     boosting::Cascade cascade = boosting::loadModel(file);
-    checkLayers(cascade, file, stackLayers);
+    checkLayers(cascade, file, stackLayers, network);
     if (!seen.insert(cascade.className).second)
       throw std::runtime_error(file.string() + ": a second model of class '" + cascade.className + "'");
     cascades.push_back(std::move(cascade));

@@ -14,8 +14,9 @@ double msSince(Clock::time_point t0) {
 }
 }  // namespace
 
-Fuser::Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, ProjectionConfig config)
-    : config_(config), undistorter_(camera) {
+Fuser::Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, ProjectionConfig config,
+             std::shared_ptr<const NeuralLayers> neural)
+    : config_(config), undistorter_(camera), neural_(std::move(neural)) {
   projection_.K = camera.K;
   projection_.sweepToCamera = sweepToCamera;
   projection_.width = camera.width;
@@ -28,6 +29,13 @@ std::vector<std::string> Fuser::layerNames() {
   return {std::string(layer::kRed),       std::string(layer::kGreen),    std::string(layer::kBlue),
           std::string(layer::kIntensity), std::string(layer::kHue),      std::string(layer::kDistance),
           std::string(layer::kRemission)};
+}
+
+std::vector<std::string> Fuser::stackLayers() const {
+  std::vector<std::string> names = layerNames();
+  if (neural_)
+    for (std::string& n : neural_->layerNames()) names.push_back(std::move(n));
+  return names;
 }
 
 LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings) const {
@@ -51,6 +59,12 @@ LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timi
   stack.set(std::move(laser.distance));
   stack.set(std::move(laser.remission));
   t.rasteriseMs = msSince(t0);
+
+  if (neural_) {
+    t0 = Clock::now();
+    neural_->add(stack, image);
+    t.neuralMs = msSince(t0);
+  }
   t.totalMs = msSince(start);
   if (timings) *timings = t;
   return stack;

@@ -2,6 +2,8 @@
 #include "fusedet/fusion/layer_sources.h"
 
 #include "fusedet/core/layer_stack.h"
+#include "fusedet/core/network_record.h"
+#include "fusedet/fusion/neural/score_layers.h"
 
 namespace fusedet::fusion {
 
@@ -10,6 +12,7 @@ LayerSource layerSource(std::string_view l) {
                              layer::kHueDistance})
     if (l == c) return LayerSource::camera;
   if (l == layer::kDistance || l == layer::kRemission) return LayerSource::laser;
+  if (isNetworkLayer(l)) return LayerSource::network;
   return LayerSource::unknown;
 }
 
@@ -17,6 +20,7 @@ std::string toString(LayerSource s) {
   switch (s) {
     case LayerSource::camera: return "camera";
     case LayerSource::laser: return "laser";
+    case LayerSource::network: return "network";
     case LayerSource::unknown: break;
   }
   return "other";
@@ -27,6 +31,15 @@ const std::vector<std::string>& paperPoolLayers() {
                                              std::string(layer::kBlue),      std::string(layer::kIntensity),
                                              std::string(layer::kHueDistance), std::string(layer::kDistance),
                                              std::string(layer::kRemission)};
+  return l;
+}
+
+const std::vector<std::string>& networkPoolLayers() {
+  static const std::vector<std::string> l = [] {
+    std::vector<std::string> names;
+    for (const ScoreLayerClass& c : defaultScoreLayers()) names.push_back(c.layer);
+    return names;
+  }();
   return l;
 }
 

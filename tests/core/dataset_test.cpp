@@ -185,6 +185,29 @@ TEST(Dataset, ReadsOnlySelectedLayersInTheRequestedOrder) {
   fs::remove_all(dir);
 }
 
+TEST(Dataset, KeepsTheNetworkOfNeuralLayers) {
+  const fs::path dir = freshDir("network");
+  DatasetItem item = sampleItem("n", "g", 3);
+  writeDatasetItem(dir, item);
+  EXPECT_EQ(slurp(dir / "items" / "n" / "item.json").find("\"network\""), std::string::npos);  // none: no key
+  item.stack.network = NetworkRecord{"yolov5-onnx", 832, 256, {"y.onnx"}, {std::string(64, 'c')}};
+  writeDatasetItem(dir, item);
+  EXPECT_EQ(readDatasetItem(dir, "n").stack.network, item.stack.network);
+  EXPECT_EQ(readDatasetItem(dir, "n", {"red"}).stack.network, item.stack.network);
+  std::string json = slurp(dir / "items" / "n" / "item.json");
+  const std::string digest = "sha256:" + std::string(64, 'c');
+  json.replace(json.find(digest), digest.size(), "sha256:cc");
+  spit(dir / "items" / "n" / "item.json", json);
+  try {
+    (void)readDatasetItem(dir, "n");
+    FAIL();
+  } catch (const DatasetError& e) {
+    EXPECT_NE(std::string(e.what()).find("item.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sha256:cc"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Dataset, RejectsBadInputNamingFileAndProblem) {
   const fs::path dir = freshDir("bad");
   EXPECT_THROW(listDataset(dir), DatasetError);  // no manifest

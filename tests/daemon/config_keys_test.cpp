@@ -101,6 +101,7 @@ fusion:
   max_pair_skew_ms: 100
   tilt_window_ms: 40
   close_on_tilt: false
+neural: {enabled: true, kind: yolov5-onnx, files: [net.onnx], directory: nets, input: "1248x384", scale: 0.25, threads: 2}
 detection: {models: [a.json], scale_factor: 1.2, min_size: [10, 20], max_size: [400, 300], step: 3,
             min_neighbors: 2, laser_extent: true, threads: 2,
             classes: {person: {min_neighbors: 5, laser_extent: false}}}

@@ -12,6 +12,7 @@
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/localize.h"
 #include "fusedet/daemon/protocol.h"
+#include "fusedet/daemon/service.h"
 #include "fusedet/daemon/stack_detector.h"
 #include "fusedet/daemon/stats.h"
 #include "fusedet/fusion/fuser.h"
@@ -244,7 +245,8 @@ TEST(DetectionSettings, ClassSettingsWithoutAModelAreReported) {
 
 // A model trained on a layer the daemon's stacks do not have (here the bundled car model with a
 // neural score layer added to its layer list) is refused when loaded, naming the file,
-// the layer and the layers fusion makes; hue_distance counts as made (derived from hue).
+// the layer and the layers fusion makes; hue_distance counts as made (derived from hue). With the
+// layer made by a network, the model must record that very network (kind, input, digests).
 TEST(DetectionSettings, AModelNeedingALayerTheStacksLackIsRefused) {
   nlohmann::json car = nlohmann::json::parse(std::ifstream(std::string(FUSEDET_SOURCE_DIR) + "/models/car.json"));
   car["layers"].push_back("neural_car");
@@ -262,13 +264,52 @@ TEST(DetectionSettings, AModelNeedingALayerTheStacksLackIsRefused) {
               std::string::npos)
         << what;
   }
-  // The same file is fine for stacks that have the layer.
+  // Stacks that have the layer: the model must record the network that makes it, the same one.
   std::vector<std::string> layers = fusion::Fuser::layerNames();
   layers.push_back("neural_car");
-  EXPECT_EQ(CascadeSet(d, {}, layers).classes(), std::vector<std::string>{"car"});
+  const NetworkRecord running{"darknet", 832, 256, {"a.cfg", "a.weights"}, {std::string(64, 'a'), std::string(64, 'b')}};
+  const auto refusal = [&] {
+    try {
+      CascadeSet set(d, {}, layers, running);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(refusal().find(file + " (class 'car'): uses neural layers but records no network"), std::string::npos)
+      << refusal();
+  NetworkRecord other = running;
+  other.inputWidth = 1248;
+  car["network"] = other.text();
+  std::ofstream(file, std::ios::trunc) << car.dump();
+  const std::string what = refusal();
+  EXPECT_NE(what.find(file + " (class 'car'): trained on neural layers of the network " + other.text()), std::string::npos)
+      << what;
+  EXPECT_NE(what.find("fusedetd's network (config section neural) has the network " + running.text()), std::string::npos)
+      << what;
+  car["network"] = running.text();
+  std::ofstream(file, std::ios::trunc) << car.dump();
+  EXPECT_EQ(CascadeSet(d, {}, layers, running).classes(), std::vector<std::string>{"car"});
   // Without hue, a model using hue_distance cannot run either.
   d.models = {std::string(FUSEDET_SOURCE_DIR) + "/models/car.json"};
   EXPECT_THROW(CascadeSet(d, {}, {"red", "green", "blue", "intensity", "distance", "remission"}), std::runtime_error);
+}
+
+// neural.enabled with a network file that is not there: fusedetd refuses to start, naming the
+// section and the file; off (the default), no network is loaded at all.
+TEST(DetectionSettings, AMissingNetworkIsNamedAtStart) {
+  Config c;
+  EXPECT_EQ(neuralLayersFrom(c, "/etc/fusedet/fusedet.yaml"), nullptr);
+  c.neural.enabled = true;
+  c.neural.directory = "nets";  // relative: to the config's folder
+  try {
+    (void)neuralLayersFrom(c, testing::TempDir() + "/fusedet.yaml");
+    FAIL() << "loaded a network that is not there";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("neural (network darknet 832x256): "), std::string::npos) << what;
+    EXPECT_NE(what.find("nets/yolo-fastest-1.1-xl.cfg: network file (darknet) not found"), std::string::npos) << what;
+  }
 }
 
 // detection.classes: each entry inherits the general min_neighbors / laser_extent it leaves out;

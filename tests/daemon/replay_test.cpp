@@ -268,7 +268,7 @@ TEST(ReplayService, FiftyMixedClientsOnAReplayingDaemonKeepersLoseNothing) {
   // run ahead of it).
   for (const auto& st : reference.stages) {
     ASSERT_TRUE(st.contains("close") && st["close"].is_number()) << st.dump();
-    for (const char* key : {"decode", "fuse", "fuse_cpu", "queue", "detect", "detect_cpu", "localize"}) {
+    for (const char* key : {"decode", "fuse", "neural", "fuse_cpu", "queue", "detect", "detect_cpu", "localize"}) {
       ASSERT_TRUE(st.contains(key)) << key << " missing in " << st.dump();
       EXPECT_GE(st[key].get<double>(), 0.0) << key;
     }

@@ -51,7 +51,7 @@ ServiceParts parts(const Config& config, const KittiScenes& k, std::unique_ptr<S
   ServiceParts p;
   p.config = config;
   p.fuser = k.fuser;
-  p.detector = detector ? detector : detectorFrom(config, {});
+  p.detector = detector ? detector : detectorFrom(config, {}, *k.fuser);
   p.sources.push_back(std::move(source));
   p.listener = bindUnixSocket(config.socket.path);
   p.mode = "scenes";

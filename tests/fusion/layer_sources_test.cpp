@@ -23,6 +23,16 @@ TEST(LayerSources, PaperPoolLayersAreTheSevenOfTheSensors) {
   for (const std::string& l : paperPoolLayers()) EXPECT_NE(layerSource(l), LayerSource::unknown) << l;
 }
 
+TEST(LayerSources, NetworkLayersAreTheirOwnSource) {
+  ASSERT_EQ(networkPoolLayers().size(), 3u);
+  for (const std::string& l : networkPoolLayers()) EXPECT_EQ(layerSource(l), LayerSource::network) << l;
+  EXPECT_EQ(toString(LayerSource::network), "network");
+  const auto by = sharesBySource({{"neural_person", 0.2}, {"neural_car", 0.3}, {"distance", 0.5}});
+  ASSERT_EQ(by.size(), 2u);
+  EXPECT_NEAR(by.at("network"), 0.5, 1e-12);
+  EXPECT_NEAR(by.at("laser"), 0.5, 1e-12);
+}
+
 TEST(LayerSources, SharesSumPerSource) {
   const std::map<std::string, double> shares = {{"red", 0.1},       {"hue_distance", 0.05}, {"distance", 0.25},
                                                 {"remission", 0.5}, {"mystery", 0.1}};

@@ -12,6 +12,7 @@
 #include "fusedet/fusion/datasets/kitti_drives.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
 #include "fusedet/fusion/datasets/kitti_tracks.h"
+#include "fusedet/fusion/layer_sources.h"
 
 namespace fusedet::tools::experiments {
 std::vector<fs::path> kittiDrives(const fs::path& root) {
@@ -47,7 +48,12 @@ fs::path resolveDataset(const ExperimentOptions& o) {
   const fs::path cache = o.datasetCache.empty() ? o.out / "dataset" : o.datasetCache;
   std::string signature;
   for (const auto& d : drives) signature += fs::absolute(d).lexically_normal().string() + "\n";
-  const fusion::KittiImportOptions import;
+  fusion::KittiImportOptions import;
+  import.neural = o.network.load();
+  if (import.neural) {
+    signature += "network " + import.neural->identity().text() + "\n";
+    std::printf("network %s\n", import.neural->identity().text().c_str());
+  }
   const fs::path marker = cache / "imported-from.txt";
   if (std::ifstream in(marker); in) {
     std::stringstream s;
@@ -101,8 +107,10 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
 }
 
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   const std::vector<std::string>& driveOf) {
-  const std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
+                                   const std::vector<std::string>& driveOf, bool withNetwork) {
+  std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
+  if (withNetwork)
+    for (const std::string& l : fusion::networkPoolLayers()) layers.push_back(l);
   std::vector<DatasetItem> items;
   items.reserve(entries.size());
   for (std::size_t i = 0; i < entries.size(); ++i) {

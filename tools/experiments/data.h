@@ -16,7 +16,8 @@ namespace fs = std::filesystem;
 std::vector<fs::path> kittiDrives(const fs::path& root);
 
 // The data set to use: --data itself when it is one, else the KITTI drives under it imported
-// once into the cache directory (a marker file records a finished import of the same drives).
+// once into the cache directory (a marker file records a finished import of the same drives and
+// network: with --network the stacks also get its score layers).
 fs::path resolveDataset(const ExperimentOptions& o);
 
 // The raw drive of every manifest entry: from the SOURCE.md of the KITTI directory the entry's
@@ -29,8 +30,9 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
                                                   const std::vector<Labels>& labels,
                                                   const std::vector<std::string>& driveOf);
 
-// Items with their raw drive as group (the folds are drive-disjoint).
+// Items with their raw drive as group (the folds are drive-disjoint); the network's score layers
+// too when `withNetwork`.
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   const std::vector<std::string>& driveOf);
+                                   const std::vector<std::string>& driveOf, bool withNetwork);
 
 }  // namespace fusedet::tools::experiments

@@ -25,6 +25,13 @@ std::string presets(T boosting::ExperimentPlan::*field) {
 }
 }  // namespace
 
+// The paper's seven layers and the network's score layers: the joint pool with one more sensor.
+std::vector<std::string> poolWithNetwork() {
+  std::vector<std::string> l = fusion::paperPoolLayers();
+  for (const std::string& n : fusion::networkPoolLayers()) l.push_back(n);
+  return l;
+}
+
 const std::vector<TrainedConfig>& trainedConfigs() {
   static const std::vector<TrainedConfig> c = {
       {"all", fusion::paperPoolLayers(), "a-j"},
@@ -32,6 +39,8 @@ const std::vector<TrainedConfig>& trainedConfigs() {
       {"laser", {"distance", "remission"}, "a-j"},
       {"camera", {"intensity", "hue_distance"}, "a-j"},
       {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
+      {"all_neural", poolWithNetwork(), "a-j"},
+      {"neural", fusion::networkPoolLayers(), "a-j"},
   };
   return c;
 }
@@ -39,7 +48,14 @@ const std::vector<TrainedConfig>& trainedConfigs() {
 const TrainedConfig& trainedConfig(const std::string& name) {
   for (const TrainedConfig& t : trainedConfigs())
     if (t.name == name) return t;
-  throw std::runtime_error("unknown configuration '" + name + "' (all, no_corners, laser, camera, four, and)");
+  throw std::runtime_error("unknown configuration '" + name +
+                           "' (all, no_corners, laser, camera, four, and, all_neural, neural)");
+}
+
+bool needsNetwork(const std::vector<std::string>& configs) {
+  for (const std::string& c : configs)
+    if (c != "and" && usesNetworkLayers(trainedConfig(c).layers)) return true;
+  return false;
 }
 
 std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option) {
@@ -191,7 +207,8 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
   app.add_option("--configs", o->configs,
                  "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
                  "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
-                 "remission), and (laser AND camera; trains both)" +
+                 "remission), and (laser AND camera; trains both), all_neural (all + the network's score layers "
+                 "neural_person, neural_bicycle, neural_car; needs --network), neural (the score layers alone)" +
                      presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
       ->delimiter(',');
   app.add_option("--config-classes", o->configClasses,
@@ -293,6 +310,9 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                "own settings (fusedet/boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, "
                "laser extent; docs/results \"Car at IoU 0.7\"), and any of those four options given applies to "
                "every class");
+  addNetworkOptions(app, o->network,
+                    "Needed by the configurations all_neural and neural: the KITTI drives are imported with the "
+                    "network's layers (a cache per network).");
   app.add_option("--class-stages", o->classStagesText,
          "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
          "stages in every configuration and the learning curve (the same cascades as training with a stage "
@@ -336,7 +356,9 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
       "  fusedet experiments --out /tmp/exp --quick                 # smoke run, a few minutes\n"
       "  nice -n 10 fusedet experiments --out /tmp/exp --threads 2  # docs/results in one run (hours)\n"
       "  fusedet experiments --out exp --classes car --configs all --learning none\n"
-      "  fusedet experiments --data ds --out exp --folds 5 --van negative");
+      "  fusedet experiments --data ds --out exp --folds 5 --van negative\n"
+      "  fusedet experiments --out exp --configs all,all_neural,neural --config-classes car,person,bike \\\n"
+      "      --network darknet --networks-dir ../shared/models --learning none --learning-positives none");
 }
 
 }  // namespace fusedet::tools::experiments

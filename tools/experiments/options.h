@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "../data_dir.h"
+#include "../network_options.h"
 #include "../training_options.h"
 #include "fusedet/boost/cascade_trainer.h"
 #include "fusedet/experiments/cross_validation.h"
@@ -60,6 +61,7 @@ struct ExperimentOptions {
   std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to
   std::vector<int> neighborsSweep;                 // min neighbours of that sweep (default: --min-neighbors)
   bool missAnalysis = true;                        // explain every missed positive of `all`
+  NetworkOptions network;                          // the network of the all_neural and neural configurations
   std::string commandLine;
 };
 
@@ -73,6 +75,9 @@ struct TrainedConfig {
 const std::vector<TrainedConfig>& trainedConfigs();
 
 const TrainedConfig& trainedConfig(const std::string& name);
+
+// Whether any configuration of the plan trains on the network's score layers.
+bool needsNetwork(const std::vector<std::string>& configs);
 
 // "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).
 std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option);

@@ -80,6 +80,8 @@ const std::vector<ConfigInfo>& paperConfigs() {
       {"camera", "Tab. 5: camera only (intensity, hue distance)"},
       {"four", "Tab. 6: hue distance, intensity, distance, remission"},
       {"and", "Tab. 7: laser-only AND camera-only cascade (Tab. 4 AND Tab. 5; a detection must pass both)"},
+      {"all_neural", "issue 30: all layers and the network's score layers (neural_person, neural_bicycle, neural_car), features a-j"},
+      {"neural", "issue 30: the network's score layers alone, features a-j"},
   };
   return c;
 }
@@ -99,7 +101,8 @@ std::vector<std::string> orderedLayers(const std::map<std::string, double>& shar
 
 std::vector<std::string> orderedSources(const std::set<std::string>& sources) {
   std::vector<std::string> out;
-  for (const auto s : {fusion::LayerSource::camera, fusion::LayerSource::laser, fusion::LayerSource::unknown})
+  for (const auto s : {fusion::LayerSource::camera, fusion::LayerSource::laser, fusion::LayerSource::network,
+                       fusion::LayerSource::unknown})
     if (sources.count(fusion::toString(s))) out.push_back(fusion::toString(s));
   return out;
 }
@@ -379,7 +382,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
        << "`, all folds together. The weight of a stump is |right - left|: the amount it moves the stage sum "
           "between its two sides. Shares are weights summed per layer, divided by the total; the second "
           "table sums them per source (fusedet/fusion/layer_sources.h: camera = red, green, blue, intensity, "
-          "hue distance; laser = distance, remission).\n\n";
+          "hue distance; laser = distance, remission; network = the network's score layers neural_*).\n\n";
     const std::vector<std::string> layers = orderedLayers(allLayers);
     std::vector<std::string> header{"class"};
     header.insert(header.end(), layers.begin(), layers.end());
@@ -414,6 +417,7 @@ std::string renderMarkdown(const ExperimentReport& r) {
     md << "\n";
   };
   weightShares("all", "## Weight share by layer (paper Fig. 7)\n\n");
+  weightShares("all_neural", "## Weight share by layer with the network's score layers (issue 30)\n\n");
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";

@@ -76,6 +76,10 @@ int runExperiments(ExperimentOptions o) {
   const std::vector<std::string>& configs = preset.configs;
   for (const std::string& c : configs)
     if (c != "and") trainedConfig(c);  // throws for unknown names
+  const bool withNetwork = needsNetwork(configs);
+  if (withNetwork && !o.network.enabled() && !fs::exists(o.data / "dataset.json"))
+    throw std::runtime_error("the configurations all_neural and neural train on a network's score layers: name it "
+                             "with --network (darknet or yolov5-onnx)");
   const fs::path cache = o.modelCache.empty() ? o.out / "fold-models" : o.modelCache;
   boosting::BootstrapConfig boot;
   boot.resamples = preset.resamples;
@@ -133,7 +137,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf);
+  std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf, withNetwork);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -364,7 +368,7 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if (config == "all" && !r.layerWeightShare.empty())
+    if ((config == "all" || config == "all_neural") && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
   };

@@ -62,6 +62,7 @@ WindowResult evaluateWindow(const Cascade& c, const IntegralStack& in, const Box
 }
 
 IntegralStack integrateFor(const Cascade& c, const LayerStack& stack) {
+  requireStackNetwork(c, stack);
   return IntegralStack(stack, c.layers, c.referenceHue);
 }
 

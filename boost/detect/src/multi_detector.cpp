@@ -20,6 +20,7 @@ std::vector<std::vector<RawHit>> MultiDetector::scan(const LayerStack& stack, co
   std::vector<LayerRequest> requests;
   for (std::size_t i = 0; i < cascades_.size(); ++i) {
     if (cascades_[i].isOpenCv()) continue;
+    requireStackNetwork(cascades_[i], stack);
     ours.push_back(&cascades_[i]);
     ourIndex.push_back(i);
     for (LayerRequest& r : layerRequests(cascades_[i])) requests.push_back(std::move(r));

@@ -15,6 +15,12 @@ std::size_t Cascade::weakCount() const {
 
 bool Cascade::hasTrees() const { return !treeStages.empty(); }
 
+void requireStackNetwork(const Cascade& c, const LayerStack& stack) {
+  if (!usesNetworkLayers(c.layers)) return;
+  requireSameNetwork(c.network, (c.source.empty() ? "the model" : c.source) + " (class '" + c.className + "')",
+                     stack.network, "the stack '" + stack.source + "'");
+}
+
 Cascade firstStages(Cascade cascade, std::size_t stages) {
   if (stages == 0) throw std::invalid_argument("firstStages: a cascade keeps at least one stage");
   if (cascade.stages.size() > stages) cascade.stages.resize(stages);

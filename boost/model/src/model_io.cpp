@@ -100,6 +100,7 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"window\": " << Json{{"width", c.windowWidth}, {"height", c.windowHeight}}.dump() << ",\n";
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
+  if (!c.network.empty()) o << "  \"network\": " << Json(c.network.text()).dump() << ",\n";
   if (!info.empty()) {
     Json t = Json::object();
     for (const auto& [k, v] : info) t[k] = v;
@@ -167,6 +168,13 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
   }
   const Json& hue = r.field(root, "", "reference_hue");
   if (!hue.is_null()) c.referenceHue = r.number(root, "", "reference_hue");
+  if (root.contains("network")) {
+    try {
+      c.network = parseNetworkRecord(r.string(root, "", "network"));
+    } catch (const std::invalid_argument& e) {
+      r.fail("network", e.what());
+    }
+  }
   // Written by --min-height-from-positives, removed (a tie cross-drive): such a model would now scan
   // from its base window, so it is refused rather than run differently without a word.
   if (root.contains("min_height"))

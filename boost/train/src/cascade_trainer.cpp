@@ -65,6 +65,24 @@ double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConf
   return hist.distinctiveHue(background);
 }
 
+namespace {
+// The network that made the training stacks' neural layers: the same for every item, or the
+// cascade would mix features of different networks under one layer name.
+NetworkRecord networkOfItems(const std::vector<DatasetItem>& items) {
+  if (items.empty()) return {};
+  const NetworkRecord& first = items.front().stack.network;
+  if (first.empty())
+    throw std::runtime_error("item " + items.front().id + " has neural layers from no recorded network (import it "
+                             "with fusedet import-kitti --network)");
+  for (const DatasetItem& item : items)
+    if (!(item.stack.network == first))
+      throw std::runtime_error("training items come from different networks: " + items.front().id + " from " +
+                               first.text() + ", " + item.id + " from " +
+                               (item.stack.network.empty() ? std::string("none") : item.stack.network.text()));
+  return first;
+}
+}  // namespace
+
 Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetItem>& items,
                      ProgressSink& progress, TrainingReport* reportOut, Collective* job) {
   const auto t0 = Clock::now();
@@ -96,6 +114,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   Cascade cascade;
   cascade.className = config.className;
   cascade.layers = layers;
+  if (usesNetworkLayers(layers)) cascade.network = networkOfItems(train);
   cascade.referenceHue = refHue;
   cascade.windowHeight = config.samples.baseWindowHeight;
   cascade.windowWidth = std::max(

@@ -70,13 +70,14 @@ PinholeProjection kittiProjection(const KittiCalib& calib, int width, int height
   return p;
 }
 
-Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config) {
+Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config,
+                 std::shared_ptr<const NeuralLayers> neural) {
   const PinholeProjection p = kittiProjection(calib, width, height);
   CameraModel camera;
   camera.width = width;
   camera.height = height;
   camera.K = p.K;
-  return Fuser(camera, p.sweepToCamera, config);
+  return Fuser(camera, p.sweepToCamera, config, std::move(neural));
 }
 
 std::vector<std::string> listKittiFrames(const fs::path& root) {

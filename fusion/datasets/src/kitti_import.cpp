@@ -6,8 +6,8 @@
 namespace fusedet::fusion {
 
 DatasetItem fuseKittiFrame(const KittiFrame& frame, const std::string& group, const ProjectionConfig& config,
-                           FuseTimings* timings) {
-  const Fuser fuser = kittiFuser(frame.calib, frame.image.cols, frame.image.rows, config);
+                           FuseTimings* timings, std::shared_ptr<const NeuralLayers> neural) {
+  const Fuser fuser = kittiFuser(frame.calib, frame.image.cols, frame.image.rows, config, std::move(neural));
   DatasetItem item;
   item.group = group;
   item.id = group + "/" + frame.id;
@@ -27,10 +27,11 @@ KittiImportStats importKitti(const std::filesystem::path& root, const std::strin
   for (const std::string& id : listKittiFrames(root)) {
     const KittiFrame frame = readKittiFrame(root, id, options.classes);
     FuseTimings t;
-    const DatasetItem item = fuseKittiFrame(frame, group, options.projection, &t);
+    const DatasetItem item = fuseKittiFrame(frame, group, options.projection, &t, options.neural);
     writeDatasetItem(datasetDir, item);
     ++stats.frames;
     stats.fuseMs += t.totalMs;
+    stats.neuralMs += t.neuralMs;
     stats.labels += item.labels.size();
     for (const Label& l : item.labels) stats.ignoreRegions += l.ignore ? 1 : 0;
     if (progress) progress(item);

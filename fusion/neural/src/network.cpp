@@ -77,11 +77,8 @@ cv::Size parseInputSize(std::string_view text) {
 
 std::string toString(NetworkKind kind) { return kind == NetworkKind::darknet ? "darknet" : "yolov5-onnx"; }
 
-std::string NetworkIdentity::text() const {
-  std::string s = toString(kind) + " " + sizeText(input);
-  for (std::size_t i = 0; i < fileNames.size(); ++i)
-    s += " " + fileNames[i] + " sha256:" + (i < sha256.size() ? sha256[i] : "?");
-  return s;
+NetworkRecord NetworkIdentity::record() const {
+  return NetworkRecord{toString(kind), input.width, input.height, fileNames, sha256};
 }
 
 struct Network::Impl {
@@ -109,6 +106,8 @@ Network::Network(const NetworkSpec& spec) : spec_(spec), impl_(std::make_unique<
   identity_.kind = spec.kind;
   identity_.input = spec.input;
   for (const auto& f : spec.files) {
+    if (f.filename().string().find(' ') != std::string::npos)
+      throw std::runtime_error(f.string() + ": a network file name must not contain spaces (stacks and models record it)");
     identity_.fileNames.push_back(f.filename().string());
     identity_.sha256.push_back(sha256File(f));
   }

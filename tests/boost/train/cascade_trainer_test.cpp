@@ -166,6 +166,47 @@ TEST(CascadeTrainer, ClearErrorsForNoPositivesAndMissingLayers) {
   EXPECT_THROW(trainCascade(c, items, quiet), std::invalid_argument);
 }
 
+// A cascade trained on a network's layers records that network (model file "network"); items of
+// different networks, or neural layers of no recorded network, are refused naming the items.
+TEST(CascadeTrainer, RecordsTheNetworkOfNeuralLayers) {
+  auto items = scenes(8, false);
+  const NetworkRecord net{"darknet", 832, 256, {"n.cfg", "n.weights"}, {std::string(64, '1'), std::string(64, '2')}};
+  for (DatasetItem& item : items) {
+    // A stand-in score layer: the intensity at half resolution, scaled to [0, 1].
+    cv::Mat half;
+    cv::resize(item.stack.at("intensity").data, half, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    half.convertTo(half, CV_32F, 1.0 / 255);
+    item.stack.set(Layer{"neural_car", half, {}});
+    item.stack.network = net;
+  }
+  TrainingConfig c = smallConfig();
+  c.pool.layers = {"intensity", "neural_car"};
+  c.maxStages = 1;
+  NullProgress quiet;
+  const Cascade trained = trainCascade(c, items, quiet);
+  EXPECT_EQ(trained.network, net);
+  EXPECT_NE(modelToText(trained).find(net.text()), std::string::npos);
+  c.pool.layers = {"intensity"};
+  EXPECT_TRUE(trainCascade(c, items, quiet).network.empty());  // no neural layer: no network
+  c.pool.layers = {"intensity", "neural_car"};
+  items[5].stack.network.inputWidth = 1248;
+  try {
+    trainCascade(c, items, quiet);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(items[5].id + " from " + items[5].stack.network.text()), std::string::npos)
+        << e.what();
+  }
+  items[0].stack.network = {};
+  try {
+    trainCascade(c, items, quiet);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(items[0].id + " has neural layers from no recorded network"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(CascadeTrainer, NegativeWindowsAvoidLabelsAndIgnoreRegions) {
   SampleConfig s;
   Labels labels(3);

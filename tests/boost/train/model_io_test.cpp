@@ -71,6 +71,36 @@ TEST(ModelIo, RoundTripIsExactAndTextIsStable) {
   EXPECT_NE(text.find("\"type\":\"g\""), std::string::npos);
 }
 
+TEST(ModelIo, TheNetworkOfNeuralLayersIsRecordedAndChecked) {
+  Cascade c = sample();
+  EXPECT_EQ(modelToText(c).find("\"network\""), std::string::npos);  // no neural layers: no key
+  c.layers = {"intensity", "neural_car"};
+  c.network = NetworkRecord{"darknet", 832, 256, {"x.cfg", "x.weights"}, {std::string(64, 'a'), std::string(64, 'b')}};
+  const std::string text = modelToText(c);
+  Cascade back = modelFromText(text, "m.json");
+  EXPECT_EQ(back.network, c.network);
+  EXPECT_EQ(modelToText(back), text);
+  // A stack of another network (or none) is refused before any window is scanned, naming both.
+  LayerStack stack(64, 48);
+  stack.set(Layer{"intensity", cv::Mat(48, 64, CV_8U, cv::Scalar(9)), {}});
+  stack.set(Layer{"neural_car", cv::Mat(24, 32, CV_32F, cv::Scalar(0.5)), {}});
+  stack.source = "kitti/000007";
+  stack.network = c.network;
+  EXPECT_NO_THROW(requireStackNetwork(back, stack));
+  stack.network.inputHeight = 384;
+  try {
+    requireStackNetwork(back, stack);
+    FAIL() << "a stack of another network was accepted";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("m.json (class 'car')"), std::string::npos) << what;
+    EXPECT_NE(what.find(c.network.text()), std::string::npos) << what;
+    EXPECT_NE(what.find(stack.network.text()), std::string::npos) << what;
+    EXPECT_NE(what.find("kitti/000007"), std::string::npos) << what;
+  }
+  EXPECT_NE(errorOf(replace(text, "darknet 832x256", "darknet 832")).find("m.json: network: "), std::string::npos);
+}
+
 TEST(ModelIo, RemovedMinimumDetectionHeightIsRefusedWithWhatToDo) {
   // No model writes "min_height" any more; a file holding it (train --min-height-from-positives,
   // removed) would scan differently now, so it is refused, naming the field and what to do.

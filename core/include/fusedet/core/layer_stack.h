@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fusedet/core/box.h"
+#include "fusedet/core/network_record.h"
 #include "fusedet/core/stamp.h"
 
 namespace fusedet {
@@ -70,6 +71,7 @@ class LayerStack {
   std::uint64_t id = 0;  // sequence number of the stack in its stream or data set
   Stamp stamp;           // time of the camera frame the stack was built from
   std::string source;    // where it came from, e.g. "kitti/000042" or "live"
+  NetworkRecord network;  // the network that made its neural_* layers (empty: none)
 
  private:
   std::vector<Layer> layers_;

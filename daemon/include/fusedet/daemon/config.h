@@ -80,6 +80,19 @@ struct Config {
     bool closeOnTilt = true;  // a tilt sample that proves the turn closes a sweep (false: the next scan)
   } fusion;
 
+  // A pretrained network as one more layer source (issue 30; fusion/neural/neural_layers.h): off by
+  // default. On, every stack also gets neural_person, neural_bicycle, neural_car from the camera
+  // image, and models trained on them must record the same network.
+  struct Neural {
+    bool enabled = false;
+    std::string kind = "darknet";              // darknet | yolov5-onnx
+    std::vector<std::string> files;            // empty = the kind's default files in `directory`
+    std::string directory = "/usr/share/fusedet/networks";  // relative: to the config's folder
+    std::string input = "832x256";             // W x H (darknet: multiples of 32)
+    double scale = 0.5;                        // score layers' grid relative to the camera image
+    int threads = 1;                           // OpenCV threads of one network run
+  } neural;
+
   struct Detection {
     // Defaults equal boosting::ScanParams{} and GroupParams{} (one meaning for every key).
     std::vector<std::string> models{"/usr/share/fusedet/models/car.json", "/usr/share/fusedet/models/bike.json",

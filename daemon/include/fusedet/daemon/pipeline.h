@@ -46,6 +46,7 @@ struct StageTimes {
                            // pairing, the sensor queue
   double decodeMs = 0;     // camera frame -> BGR image
   double fuseMs = 0;       // Fuser::fuse: undistortion, camera layers, projection, laser layers
+  double neuralMs = 0;     // of fuseMs: the network's score layers (config section neural; 0 when off)
   double fuseCpuMs = 0;    // the fusion thread's CPU time for decode + fuse
   double queueMs = 0;      // in the stack queue, waiting for the detection thread
   double detectMs = 0;     // every class: integrals, window scan, grouping
@@ -129,6 +130,8 @@ class Pipeline : public SensorSink {
   // Swaps the detector between two stacks (SIGHUP reload).
   void setDetector(std::shared_ptr<const StackDetector> detector);
   std::shared_ptr<const StackDetector> detector() const;
+  // The fuser (fixed for the pipeline's life): the layers and network its stacks have.
+  const fusion::Fuser& fuser() const { return *setup_.fuser; }
 
   // SensorSink: never block.
   void onScan(drivers::LaserScan scan) override;

@@ -44,9 +44,16 @@ struct ServiceParts {
 // Fusion settings (camera calibration file, extrinsics, laser layers) of a config; a relative
 // calibration path is relative to the config file's folder. Throws std::runtime_error naming the
 // calibration file on failure.
+// With neural.enabled the fuser also makes the network's score layers (neuralLayersFrom).
 std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const std::filesystem::path& configFile);
-// The same with a camera model already read (replay: the log's camera.yaml).
-std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera);
+// The same with a camera model already read (replay: the log's camera.yaml) and the network (or none).
+std::shared_ptr<const fusion::Fuser> fuserFrom(const Config& config, const fusion::CameraModel& camera,
+                                               std::shared_ptr<const fusion::NeuralLayers> neural = {});
+// The network of the config's neural section, loaded (null when neural.enabled is false); a
+// relative neural.directory is relative to the config file's folder. Throws std::runtime_error
+// naming the section and the file when it cannot be loaded (missing file, wrong kind or input size).
+std::shared_ptr<const fusion::NeuralLayers> neuralLayersFrom(const Config& config,
+                                                             const std::filesystem::path& configFile);
 // Throw std::runtime_error naming the key when a group of socket.group / socket.allow_groups
 // does not exist on this machine.
 ServerLimits serverLimitsFrom(const Config& config);
@@ -54,8 +61,10 @@ SocketAccess socketAccessFrom(const Config& config);
 // The pipeline the parts ask for: their fuser, sweep assembly and pairing of the sensors' rig
 // (sensorConfig, else config), lossless as set, the tracker of config.tracking. Takes the fuser.
 PipelineSetup pipelineSetup(ServiceParts& parts);
-// Models resolve relative to the config file's folder.
-std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile);
+// Models resolve relative to the config file's folder; each must run on `fuser`'s stacks (its
+// layers, and for neural layers its network: CascadeSet).
+std::shared_ptr<const StackDetector> detectorFrom(const Config& config, const std::filesystem::path& configFile,
+                                                  const fusion::Fuser& fuser);
 
 class Service {
  public:

@@ -40,9 +40,11 @@ class CascadeSet : public StackDetector {
   // Loads every model file (relative paths against `base`); throws std::runtime_error naming the
   // file and the problem (missing, malformed, invalid cascade, two models of one class, a layer the
   // stacks will not have: `stackLayers` are the layers fusion makes, fusion::Fuser::layerNames(),
-  // plus hue_distance when hue is among them).
+  // plus hue_distance when hue is among them; a model using neural layers must record `network`,
+  // the network that makes the stacks' ones: fusedet/core/network_record.h requireSameNetwork).
   CascadeSet(const Config::Detection& settings, const std::filesystem::path& base = {},
-             const std::vector<std::string>& stackLayers = fusion::Fuser::layerNames());
+             const std::vector<std::string>& stackLayers = fusion::Fuser::layerNames(),
+             const NetworkRecord& network = {});
 
   std::vector<Detection> detect(const LayerStack& stack) const override;
   std::vector<std::string> classes() const override;

@@ -4,12 +4,18 @@
 // intensity, hue) at image resolution and the laser layers (distance, remission, with a validity
 // mask) at their own lower resolution, registered through the undistorted image plane.
 // The same code serves live data (distorted camera, extrinsics from config) and KITTI (rectified
-// camera, calib files).
+// camera, calib files). With a network configured (NeuralLayers, fusion/neural) the stack also
+// gets the network's score layers, made from the undistorted image (one code path for KITTI
+// import, `fusedet detect` and fusedetd).
 
+#include <memory>
 #include <opencv2/core/mat.hpp>
+#include <string>
+#include <vector>
 
 #include "fusedet/core/layer_stack.h"
 #include "fusedet/fusion/camera_model.h"
+#include "fusedet/fusion/neural/neural_layers.h"
 #include "fusedet/fusion/projection.h"
 #include "fusedet/fusion/sweep.h"
 #include "fusedet/fusion/undistorter.h"
@@ -18,13 +24,15 @@ namespace fusedet::fusion {
 
 // Wall time of each step of one fuse() call, in milliseconds.
 struct FuseTimings {
-  double undistortMs = 0, cameraLayersMs = 0, projectMs = 0, rasteriseMs = 0, totalMs = 0;
+  double undistortMs = 0, cameraLayersMs = 0, neuralMs = 0, projectMs = 0, rasteriseMs = 0, totalMs = 0;
 };
 
 class Fuser {
  public:
   // sweepToCamera maps sweep points (Sweep::frame) to the camera frame (x right, y down, z ahead).
-  Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, ProjectionConfig config = {});
+  // `neural` (optional): the network whose score layers every stack also gets.
+  Fuser(const CameraModel& camera, const Eigen::Isometry3d& sweepToCamera, ProjectionConfig config = {},
+        std::shared_ptr<const NeuralLayers> neural = {});
 
   // bgr: the camera image as captured (distorted, the model's size), CV_8UC3. The stack's stamp
   // and source are left to the caller.
@@ -33,6 +41,11 @@ class Fuser {
   // The layers fuse() makes, in its order (a model needing any other cannot run on its stacks;
   // hue_distance is derived from hue per model at detection time).
   static std::vector<std::string> layerNames();
+  // The layers this Fuser's stacks have: layerNames(), then the network's when one is configured.
+  std::vector<std::string> stackLayers() const;
+  // The network that makes the stacks' neural layers (empty: none).
+  NetworkRecord network() const { return neural_ ? neural_->record() : NetworkRecord{}; }
+  const std::shared_ptr<const NeuralLayers>& neural() const { return neural_; }
 
   const PinholeProjection& projection() const { return projection_; }
   const ProjectionConfig& config() const { return config_; }
@@ -42,6 +55,7 @@ class Fuser {
   PinholeProjection projection_;
   ProjectionConfig config_;
   Undistorter undistorter_;
+  std::shared_ptr<const NeuralLayers> neural_;
 };
 
 }  // namespace fusedet::fusion

@@ -23,6 +23,8 @@
 #include <vector>
 
 #include "fusedet/boost/feature.h"
+#include "fusedet/core/layer_stack.h"
+#include "fusedet/core/network_record.h"
 
 namespace fusedet::boosting {
 
@@ -72,6 +74,7 @@ struct Cascade {
   int windowWidth = 24, windowHeight = 24;  // base window in pixels (aspect ratio = w / h)
   std::vector<std::string> layers;          // layer names the features index
   std::optional<double> referenceHue;       // degrees, for a "hue_distance" layer
+  NetworkRecord network;                    // the network that made its neural_* layers (empty: none)
   Normalization normalization = Normalization::kNone;
   std::vector<Feature> features;          // kNone
   std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
@@ -95,6 +98,11 @@ struct Cascade {
   // stumps and trees, a tree whose children do not follow their parent.
   void validate() const;
 };
+
+// A cascade that uses neural_* layers needs a stack whose network (LayerStack::network) is the one
+// it was trained on; throws std::runtime_error naming the model, the stack and both networks
+// (fusedet/core/network_record.h requireSameNetwork). Nothing for a cascade without such layers.
+void requireStackNetwork(const Cascade& cascade, const LayerStack& stack);
 
 // The cascade's first `stages` stages (all of them when it has no more). Training adds stages in
 // order, each from the cascade before it with its own per-stage seed (cascade_trainer.h), so this

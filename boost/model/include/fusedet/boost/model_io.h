@@ -12,6 +12,8 @@
 //     "window": {"width":40,"height":24},
 //     "layers": ["intensity","distance"],
 //     "reference_hue": 25,
+//     "network": "darknet 832x256 yolo-fastest-1.1-xl.cfg sha256:... ...",  (only with neural_* layers:
+//                the network that made them, fusedet/core/network_record.h)
 //     "training": {"seed":"1", ...},          (optional, informative, ignored when loading)
 //     "stages": [
 //       {"threshold":-0.41,"stumps":[

@@ -55,6 +55,8 @@ KittiFrame readKittiFrame(const std::filesystem::path& root, const std::string& 
 // [I | K^-1 P2(:, 3)] * R0_rect * Tr_velo_to_cam, hence K * (T * X) = P2 * R0_rect * Tr * X.
 PinholeProjection kittiProjection(const KittiCalib& calib, int width, int height);
 // A Fuser for a KITTI camera (no distortion: image_2 is rectified).
-Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config = {});
+// `neural` (optional): the network whose score layers the stacks also get.
+Fuser kittiFuser(const KittiCalib& calib, int width, int height, const ProjectionConfig& config = {},
+                 std::shared_ptr<const NeuralLayers> neural = {});
 
 }  // namespace fusedet::fusion

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "fusedet/core/dataset.h"
@@ -16,17 +17,19 @@ namespace fusedet::fusion {
 struct KittiImportOptions {
   ProjectionConfig projection;
   KittiClassMap classes;  // Van -> "van" by default: a hard negative for car, not an ignore region
+  std::shared_ptr<const NeuralLayers> neural;  // optional: the network's score layers too (fuser.h)
 };
 
 // Fuses one read frame into a data set item with id "<group>/<frame id>".
 DatasetItem fuseKittiFrame(const KittiFrame& frame, const std::string& group, const ProjectionConfig& config,
-                           FuseTimings* timings = nullptr);
+                           FuseTimings* timings = nullptr, std::shared_ptr<const NeuralLayers> neural = {});
 
 struct KittiImportStats {
   std::size_t frames = 0;
   std::size_t labels = 0;         // all labels written, ignore regions included
   std::size_t ignoreRegions = 0;
   double fuseMs = 0;              // summed Fuser time (reading and writing files excluded)
+  double neuralMs = 0;            // of which the network's score layers
 };
 
 // Imports every frame of `root` (listKittiFrames order) into `datasetDir` under `group`.

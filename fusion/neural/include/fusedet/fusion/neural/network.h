@@ -21,6 +21,7 @@
 #include <string_view>
 #include <vector>
 
+#include "fusedet/core/network_record.h"
 #include "fusedet/fusion/neural/anchors.h"
 #include "fusedet/fusion/neural/input_geometry.h"
 
@@ -45,8 +46,10 @@ struct NetworkIdentity {
   std::vector<std::string> fileNames;  // file names without folders, as given
   std::vector<std::string> sha256;     // lower-case hex, parallel to fileNames
   cv::Size input;
+  // The same as core's NetworkRecord, which stacks and model files carry.
+  NetworkRecord record() const;
   // "yolov5-onnx 832x256 yolov5n_256x832.onnx sha256:a4e8..." (every file with its digest).
-  std::string text() const;
+  std::string text() const { return record().text(); }
   bool operator==(const NetworkIdentity& o) const {
     return kind == o.kind && fileNames == o.fileNames && sha256 == o.sha256 && input == o.input;
   }
