@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-m", maxT, "largest start translation error [m] (drawn from [0, 1] x this)")->capture_default_str();
   app.add_option("--measure", measure, "mi, edges, both")->capture_default_str();
   app.add_option("--levels", levels, "pyramid levels")->capture_default_str();
-  app.add_option("--hold", hold, "axes kept at the start: rx ry rz tx ty tz, comma-separated");
+  app.add_option("--hold", hold, "axes kept at the start: rx ry rz tx ty tz, comma-separated")->delimiter(',');
   app.add_option("--limit-deg", limitDeg, "a trial is within the limits at this rotation error [deg]; an axis is flagged "
                                           "when its 1-sigma exceeds it")->capture_default_str();
   app.add_option("--limit-m", limitT, "likewise for translation [m]")->capture_default_str();
@@ -153,9 +153,7 @@ int main(int argc, char** argv) {
     else if (anyHeld) ++heldOutside;
     else ++silentOutside;
     if (!ok && !isFlagged && beyond3Sigma) ++silentBeyond3Sigma;
-    std::string names;
-    for (int a = 0; a < 6; ++a)
-      if (flagged[static_cast<std::size_t>(a)]) names += std::string(names.empty() ? "" : ",") + calibAxisName(a);
+    const std::string names = calibAxisList(flagged, ",");
     std::printf("%5d %6zu %9.2f %7.3f %8.3f %6.3f   %6.3f %6.3f %6.3f %5.1f %5.1f %5.1f | %5.3f %5.3f %5.3f %4.1f %4.1f %4.1f | %-8s %5.1f\n",
                 t, frames.size(), rotationErrorDeg(start, all.laserToCamera), translationError(start, all.laserToCamera), eDeg,
                 eM, e(0), e(1), e(2), 100 * e(3), 100 * e(4), 100 * e(5), s(0), s(1), s(2), 100 * s(3), 100 * s(4),

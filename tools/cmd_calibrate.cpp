@@ -131,20 +131,15 @@ int runCalibrate(const CalibrateOptions& o) {
   } else {
     std::printf("sigma     not estimated (needs 3 or more frames and no --no-uncertainty)\n");
   }
-  std::string held;
-  for (int a = 0; a < 6; ++a)
-    if (opt.hold[static_cast<std::size_t>(a)]) held += std::string(held.empty() ? "" : " ") + fusion::calibAxisName(a);
+  const std::string held = fusion::calibAxisList(opt.hold, " ");
   if (!held.empty()) {
     std::printf("held      %s: kept at the start\n", held.c_str());
     comment << "\nheld at the start: " << held;
   }
   const Eigen::Matrix<double, 6, 1> sigma = fusion::sigmaPerAxis(r);
   const fusion::CalibAxes uncertain = fusion::uncertainAxes(r, opt.hold, o.maxSigmaDeg, o.maxSigmaM);
-  std::string uncertainNames, holdList;
   for (int a = 0; a < 6; ++a) {
     if (!uncertain[static_cast<std::size_t>(a)]) continue;
-    uncertainNames += std::string(uncertainNames.empty() ? "" : " ") + fusion::calibAxisName(a);
-    holdList += std::string(holdList.empty() ? "" : ",") + fusion::calibAxisName(a);
     char line[200];
     if (std::isnan(sigma(a)))
       std::snprintf(line, sizeof line, "%s: no 1-sigma (needs 3 or more frames and no --no-uncertainty)", fusion::calibAxisName(a));
@@ -155,10 +150,11 @@ int runCalibrate(const CalibrateOptions& o) {
     std::printf("uncertain %s\n", line);
     comment << "\nuncertain " << line;
   }
+  const std::string uncertainNames = fusion::calibAxisList(uncertain, " ");
   if (!uncertainNames.empty() && !o.force) {
     std::printf("not written: the frames do not constrain %s. Add frames with structure at several distances, hold the axis at "
                 "a start you trust (--hold %s, e.g. measured with a tape), or write anyway with --force.\n",
-                uncertainNames.c_str(), holdList.c_str());
+                uncertainNames.c_str(), fusion::calibAxisList(uncertain, ",").c_str());
     return 3;
   }
   if (o.out.has_parent_path()) fs::create_directories(o.out.parent_path());
@@ -255,6 +251,7 @@ const bool registered = registerCommand(
                                                         "--force or --hold them)");
       app.add_option("--hold", o->hold, "axes kept at the start, never searched: rx ry rz (rotations about the camera's x right, "
                                         "y down, z ahead), tx ty tz (translations), comma-separated or repeated")
+          ->delimiter(',')
           ->check([](const std::string& v) {
             try {
               fusion::parseCalibAxes({v});

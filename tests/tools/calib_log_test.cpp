@@ -138,7 +138,8 @@ TEST(CalibLog, HeldAxesStayAtTheStartAndAreNeverUncertain) {
   fusion::TargetlessOptions opt;
   opt.measure = fusion::AlignmentMeasure::kBoth;
   opt.pyramidLevels = 2;
-  opt.hold = fusion::parseCalibAxes({"rz,ty", "tz"});
+  opt.hold = fusion::parseCalibAxes({"rz", "ty", "tz"});
+  EXPECT_EQ(fusion::calibAxisList(opt.hold, ","), "rz,ty,tz");
   const fusion::TargetlessResult r = fusion::calibrateTargetless(in.frames, in.K, start, opt);
   const Eigen::Matrix<double, 6, 1> moved = fusion::poseDifference(r.laserToCamera, start);
   const Eigen::Matrix<double, 6, 1> sigma = fusion::sigmaPerAxis(r);
@@ -150,8 +151,11 @@ TEST(CalibLog, HeldAxesStayAtTheStartAndAreNeverUncertain) {
   const fusion::CalibAxes uncertain = fusion::uncertainAxes(r, opt.hold, 1e-9, 1e-9);
   for (int a = 0; a < 6; ++a)
     EXPECT_EQ(uncertain[static_cast<std::size_t>(a)], !opt.hold[static_cast<std::size_t>(a)]) << fusion::calibAxisName(a);
-  EXPECT_THROW(fusion::parseCalibAxes({"tx,yaw"}), std::invalid_argument);
-  opt.hold = fusion::parseCalibAxes({"rx,ry,rz,tx,ty,tz"});
+  EXPECT_THROW(fusion::parseCalibAxes({"tx", "yaw"}), std::invalid_argument);
+  EXPECT_THROW(fusion::parseCalibAxes({"tx,ty"}), std::invalid_argument) << "the command line splits lists, not the library";
+  opt.hold = fusion::parseCalibAxes({"rx", "ry", "rz", "tx", "ty", "tz"});
+  EXPECT_EQ(fusion::calibAxisList(opt.hold, " "), "rx ry rz tx ty tz");
+  EXPECT_EQ(fusion::calibAxisList(fusion::CalibAxes{}, " "), "");
   EXPECT_THROW(fusion::calibrateTargetless(in.frames, in.K, start, opt), std::invalid_argument) << "nothing left to search";
 }
 

@@ -100,20 +100,20 @@ const char* calibAxisName(int axis) {
   return axis >= 0 && axis < 6 ? kNames[axis] : "?";
 }
 
+std::string calibAxisList(const CalibAxes& axes, const char* separator) {
+  std::string out;
+  for (int a = 0; a < 6; ++a)
+    if (axes[static_cast<std::size_t>(a)]) out += (out.empty() ? "" : separator) + std::string(calibAxisName(a));
+  return out;
+}
+
 CalibAxes parseCalibAxes(const std::vector<std::string>& names) {
   CalibAxes axes{};
-  for (const std::string& list : names) {
-    std::size_t start = 0;
-    while (start <= list.size()) {
-      std::size_t end = list.find(',', start);
-      if (end == std::string::npos) end = list.size();
-      const std::string name = list.substr(start, end - start);
-      int axis = 0;
-      while (axis < 6 && name != calibAxisName(axis)) ++axis;
-      if (axis == 6) throw std::invalid_argument("unknown axis '" + name + "' (expected rx, ry, rz, tx, ty, tz)");
-      axes[static_cast<std::size_t>(axis)] = true;
-      start = end + 1;
-    }
+  for (const std::string& name : names) {
+    int axis = 0;
+    while (axis < 6 && name != calibAxisName(axis)) ++axis;
+    if (axis == 6) throw std::invalid_argument("unknown axis '" + name + "' (expected rx, ry, rz, tx, ty, tz)");
+    axes[static_cast<std::size_t>(axis)] = true;
   }
   return axes;
 }

@@ -58,7 +58,9 @@ struct CalibFrame {
 // z ahead): rotations rx ry rz, translations tx ty tz, in that order everywhere below.
 using CalibAxes = std::array<bool, 6>;
 const char* calibAxisName(int axis);  // "rx" ... "tz"
-// "tz", "rx,tz" (repeatable) -> the axes named; throws std::invalid_argument naming an unknown one.
+// The names of the axes set, in axis order, joined by separator ("" when none is set).
+std::string calibAxisList(const CalibAxes& axes, const char* separator);
+// {"tz"}, {"rx", "tz"} -> the axes named; throws std::invalid_argument naming an unknown one.
 CalibAxes parseCalibAxes(const std::vector<std::string>& names);
 // a relative to b about the camera axes: the rotation vector [deg] and the translation [m] of
 // a * b^-1 (the 1-sigma of a result and its error against a truth are in these units).
