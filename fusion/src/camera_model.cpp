@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <opencv2/core.hpp>
 #include <sstream>
@@ -109,6 +110,34 @@ CameraModel parseCameraModel(const std::string& text, const std::string& what) {
   CameraModel m = opencv ? parseOpenCv(text, what) : parseRos(text, what);
   validate(m, what);
   return m;
+}
+
+std::string formatCameraModel(const CameraModel& m, const std::string& cameraName, const std::string& comment) {
+  auto number = [](double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return std::string(buf);
+  };
+  auto matrix = [&](const std::string& key, int rows, int cols, const std::vector<double>& data) {
+    std::string out = key + ":\n  rows: " + std::to_string(rows) + "\n  cols: " + std::to_string(cols) + "\n  data: [";
+    for (std::size_t i = 0; i < data.size(); ++i) out += (i ? ", " : "") + number(data[i]);
+    return out + "]\n";
+  };
+  std::string out;
+  std::istringstream lines(comment);
+  for (std::string line; std::getline(lines, line);) out += "# " + line + "\n";
+  out += "image_width: " + std::to_string(m.width) + "\nimage_height: " + std::to_string(m.height) + "\n";
+  out += "camera_name: " + cameraName + "\n";
+  std::vector<double> k(9), p(12, 0.0);
+  for (int i = 0; i < 9; ++i) k[static_cast<std::size_t>(i)] = m.K(i / 3, i % 3);
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) p[static_cast<std::size_t>(4 * r + col)] = m.K(r, col);
+  out += matrix("camera_matrix", 3, 3, k);
+  out += std::string("distortion_model: ") + (m.distortion.size() <= 5 ? "plumb_bob" : "rational_polynomial") + "\n";
+  out += matrix("distortion_coefficients", 1, static_cast<int>(m.distortion.size()), m.distortion);
+  out += matrix("rectification_matrix", 3, 3, {1, 0, 0, 0, 1, 0, 0, 0, 1});
+  out += matrix("projection_matrix", 3, 4, p);
+  return out;
 }
 
 CameraModel readCameraModel(const std::filesystem::path& file) {

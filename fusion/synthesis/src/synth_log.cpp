@@ -89,12 +89,9 @@ std::string SynthRig::configYaml() const {
 }
 
 std::string SynthRig::cameraYaml() const {
-  std::ostringstream y;
-  y << "image_width: " << camera.width << "\nimage_height: " << camera.height << "\ncamera_name: synthetic\n"
-    << "camera_matrix:\n  rows: 3\n  cols: 3\n  data: [";
-  for (int i = 0; i < 9; ++i) y << (i ? ", " : "") << num(camera.K(i / 3, i % 3));
-  y << "]\ndistortion_model: plumb_bob\ndistortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [0, 0, 0, 0, 0]\n";
-  return y.str();
+  CameraModel undistorted = camera;
+  if (undistorted.distortion.empty()) undistorted.distortion.assign(5, 0.0);  // say "none" explicitly
+  return formatCameraModel(undistorted, "synthetic", "");
 }
 
 SynthReport synthesizeLog(const SynthOptions& options, const std::filesystem::path& out) {

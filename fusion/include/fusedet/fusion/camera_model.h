@@ -32,6 +32,11 @@ struct CameraModel {
 CameraModel readCameraModel(const std::filesystem::path& file);
 CameraModel parseCameraModel(const std::string& yamlText, const std::string& what = "camera YAML");
 
+// The ROS camera_info YAML parseCameraModel reads back (distortion_model plumb_bob for 4 or 5
+// coefficients, else rational_polynomial; rectification identity, projection [K | 0]), with
+// `comment` as leading '#' lines. Doubles at 17 significant digits: the text round-trips exactly.
+std::string formatCameraModel(const CameraModel& camera, const std::string& cameraName, const std::string& comment);
+
 // A rigid transform from roll/pitch/yaw in degrees applied as Rz(yaw) * Ry(pitch) * Rx(roll),
 // then the translation: p' = R p + t (the `fusion.laser_to_camera` config convention).
 Eigen::Isometry3d rigidFromRpyDeg(const std::array<double, 3>& rpyDeg, const std::array<double, 3>& translation);
