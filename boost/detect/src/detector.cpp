@@ -2,13 +2,13 @@
 #include "fusedet/boost/detector.h"
 
 #include "fusedet/boost/integral_grids.h"
+#include "fusedet/boost/parallel_for.h"
 #include "opencv_pyramid.h"
 #include "fusedet/boost/scalar_scan.h"
 #include "fusedet/boost/window_scanner.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -29,7 +29,7 @@ void forEachRow(std::size_t rows, int threads, const Body& body) {
     return;
   }
   auto run = [&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows), [&](const tbb::blocked_range<std::size_t>& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, rows), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
     });
   };

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/integral_grids.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -184,7 +184,7 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
   auto all = [&] {
-    tbb::parallel_for(
+    parallelForEach(
         std::size_t(0), order.size(), [&](std::size_t k) { run(order[k]); }, tbb::simple_partitioner());
   };
   if (threads > 1) {

@@ -4,10 +4,10 @@
 #include "fusedet/boost/vector_path.h"
 
 #include "fusedet/boost/opencv_cascade.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -518,7 +518,7 @@ std::vector<RawHit> scanOpenCvPyramid(const Cascade& c, const LayerStack& stack,
       for (int ri = 0; ri < rows; ++ri) row(ri);
     } else {
       auto run = [&] {
-        tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& r) {
+        parallelFor(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& r) {
           for (int ri = r.begin(); ri != r.end(); ++ri) row(ri);
         });
       };

@@ -3,7 +3,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/info.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include <tuple>
 
 #include "fusedet/boost/float_cut.h"
+#include "fusedet/boost/parallel_for.h"
 #include "fusedet/boost/vector_path.h"
 
 // GCC only: the vector copies get their instruction sets from `#pragma GCC target`, which clang
@@ -582,7 +582,7 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   if (params.threads == 1) {
     for (std::size_t j = 0; j < planJobs.size(); ++j) plan(j);
   } else {
-    onThreads(params.threads, [&] { tbb::parallel_for(std::size_t(0), planJobs.size(), plan); });
+    onThreads(params.threads, [&] { parallelForEach(std::size_t(0), planJobs.size(), plan); });
   }
   // Work items: tiles of one scale of one cascade (a band of window columns, a few rows), all in
   // one index space so that threads share the work across cascades and scales. Ordered by scale,
@@ -621,7 +621,7 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
     for (std::size_t i = 0; i < items.size(); ++i) runItem(i, l);
   } else {
     onThreads(params.threads, [&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, items.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+      parallelFor(tbb::blocked_range<std::size_t>(0, items.size()), [&](const tbb::blocked_range<std::size_t>& r) {
         WindowList l;
         for (std::size_t i = r.begin(); i != r.end(); ++i) runItem(i, l);
       });

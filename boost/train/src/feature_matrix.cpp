@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/feature_matrix.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -138,7 +138,7 @@ FeatureMatrix buildFeatureMatrix(std::size_t features, std::size_t samples,
   const std::size_t blocks = (features + block - 1) / block;
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1),
+    parallelFor(tbb::blocked_range<std::size_t>(0, blocks, 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         std::vector<float> buf;
                         for (std::size_t b = r.begin(); b != r.end(); ++b) {

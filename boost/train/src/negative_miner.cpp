@@ -2,12 +2,12 @@
 #include "fusedet/boost/negative_miner.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <random>
 
 #include "fusedet/boost/scalar_scan.h"
+#include "fusedet/boost/parallel_for.h"
 #include "fusedet/boost/window_scanner.h"
 
 namespace fusedet::boosting {
@@ -66,7 +66,7 @@ void forEachStack(std::size_t n, int threads, const Body& body) {
   }
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, n, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t s = r.begin(); s != r.end(); ++s) body(s);
     });
   });

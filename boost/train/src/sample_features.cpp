@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/sample_features.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -91,7 +91,7 @@ PositiveFeatures::PositiveFeatures(const TrainingStacks& stacks, std::span<const
   const std::size_t blocks = (pool.size() + kBlock - 1) / kBlock;
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, blocks, 1), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t b = r.begin(); b != r.end(); ++b) {
         const std::size_t first = b * kBlock, count = std::min(kBlock, pool.size() - first);
         values.block(first, count, std::span<float>(values_).subspan(first * positives_, count * positives_));

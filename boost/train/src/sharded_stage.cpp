@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/sharded_stage.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -111,7 +111,7 @@ void ShardedStage::buildMatrix() {
     const std::size_t count = std::min(kValueBlock, features - first);
     buf.assign(count * nLocal, 0.f);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+      parallelFor(tbb::blocked_range<std::size_t>(0, count, 16), [&](const tbb::blocked_range<std::size_t>& r) {
         values_.block(first + r.begin(), r.size(), std::span<float>(buf).subspan(r.begin() * nLocal, r.size() * nLocal));
       });
     });
@@ -123,7 +123,7 @@ void ShardedStage::buildMatrix() {
       throw std::runtime_error("sharded stage: gathered " + std::to_string(all.size()) + " subsample values, expected " +
                                std::to_string(count * take) + " (ranks disagree about the samples)");
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count), [&](const tbb::blocked_range<std::size_t>& r) {
+      parallelFor(tbb::blocked_range<std::size_t>(0, count), [&](const tbb::blocked_range<std::size_t>& r) {
         std::vector<float> global(take);
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
           std::size_t at = 0, g = 0;
@@ -179,7 +179,7 @@ FittedStump ShardedStage::findStump(std::span<const float> weights, std::span<fl
     const std::size_t count = std::min(kHistChunk, features - first);
     hist.assign(count * 2 * kBins, 0);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 8), [&](const tbb::blocked_range<std::size_t>& r) {
+      parallelFor(tbb::blocked_range<std::size_t>(0, count, 8), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
           const std::uint8_t* bins = matrix_.row(first + k);
           std::int32_t* pos = hist.data() + k * 2 * kBins;

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/stump.h"
+#include "fusedet/boost/parallel_for.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -195,7 +195,7 @@ std::vector<SplitCandidate> bestBinnedSplits(const FeatureMatrix& m, std::size_t
   std::vector<std::vector<SplitCandidate>> perChunk(chunks);
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1),
+    parallelFor(tbb::blocked_range<std::size_t>(0, chunks, 1),
                       [&](const tbb::blocked_range<std::size_t>& r) {
                         alignas(64) float pos[2][kLanes][kBins];
                         alignas(64) float neg[2][kLanes][kBins];

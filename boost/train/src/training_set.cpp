@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/training_set.h"
+#include "fusedet/boost/parallel_for.h"
 
 #include <opencv2/core.hpp>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -113,7 +113,7 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
   } else {
     tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
     arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, source.size(), 1),
+      parallelFor(tbb::blocked_range<std::size_t>(0, source.size(), 1),
                         [&](const tbb::blocked_range<std::size_t>& r) {
                           for (std::size_t k = r.begin(); k != r.end(); ++k) integrate(k);
                         });
