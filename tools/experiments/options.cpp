@@ -172,6 +172,7 @@ boosting::ChainSpec chainFor(const ExperimentOptions& o, const boosting::Experim
     spec.parts = {trainingConfig(o, p, cls, trainedConfig(config), match)};
   }
   spec.keepStages = keptStages(o, cls);
+  spec.trainingLabels = o.trainLabelsKey;
   return spec;
 }
 
@@ -190,8 +191,14 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                  "where KITTI drives are imported to (default: OUT/dataset); reused when it holds a finished "
                  "import of the same drives");
   app.add_option("--model-cache", o->modelCache,
-                 "fold models, one file per hash of training configuration + training item ids (default: "
+                 "fold models, one file per hash of training configuration + training item ids (+ the labels of "
+                 "--train-labels) (default: "
                  "OUT/fold-models); reused when present - use a fresh one after changing the trainer");
+  app.add_option("--train-labels", o->trainLabels,
+                 "train on the labels of this data set instead (the same items, e.g. a copy labelled by fusedet "
+                 "autolabel: teacher only with --replace-human, or teacher + human); every frame is still scored "
+                 "against the labels of --data. Fold models trained on them get their own cache keys")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--models-out", o->modelsOut,
                  "also train each class's all-layers cascade on every frame and write DIR/<class>.json");
   app.add_option("--preset", o->preset,

@@ -27,6 +27,8 @@ struct ExperimentOptions {
   fs::path datasetCache;  // default OUT/dataset
   fs::path modelCache;    // default OUT/fold-models
   fs::path modelsOut;     // optional: the all-layers model per class trained on every frame
+  fs::path trainLabels;   // optional: a data set of the same items whose labels the cascades train on
+  std::string trainLabelsKey;  // its labelsKey() once read by runExperiments (chainFor() passes it on)
   std::string preset = "bundled";  // boosting::experimentPlan(); the fields below override it
   std::vector<std::string> classes = {"car", "person", "bike"};
   std::vector<std::string> configs;        // empty = the preset's

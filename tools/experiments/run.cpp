@@ -36,6 +36,7 @@
 #include "fusedet/boost/outcomes_file.h"
 #include "fusedet/experiments/cross_validation.h"
 #include "fusedet/experiments/experiment_plan.h"
+#include "fusedet/experiments/training_labels.h"
 #include "fusedet/fusion/layer_sources.h"
 #include "peers.h"
 #include "report.h"
@@ -242,13 +243,29 @@ int runExperiments(ExperimentOptions o) {
   report.learningFolds = foldsText(learningFolds.size(), driveCount);
 
   // Training labels per class (fusedet/boost/class_rules.h trainingLabels()): the evaluation positives,
-  // every other label of the class an ignored label; the test frames keep their labels.
+  // every other label of the class an ignored label; the test frames keep their labels. With
+  // --train-labels they come from that data set's copy of each item (training_labels.h).
+  std::vector<Labels> trainLabels = labels;
+  if (!o.trainLabels.empty()) {
+    trainLabels = boosting::readTrainingLabels(o.trainLabels, items);
+    o.trainLabelsKey = boosting::labelsKey(trainLabels);
+    std::string counts;
+    for (const std::string& cls : o.classes) {
+      const boosting::MatchConfig m = matchFor(cls);
+      counts += (counts.empty() ? "" : "; ") + cls + " " +
+                std::to_string(boosting::countInstances(trainLabels, m).positives) + " positives (" +
+                std::to_string(boosting::countInstances(labels, m).positives) + " in the data set tested on)";
+    }
+    report.settings["training labels (--train-labels)"] = "`" + o.trainLabels.string() + "` (labels key " +
+                                                          o.trainLabelsKey + "): " + counts;
+    std::printf("training labels from %s: %s\n", o.trainLabels.c_str(), counts.c_str());
+  }
   std::map<std::string, std::vector<DatasetItem>> trainItemsOf;  // layers are shared, only labels differ
   for (const std::string& cls : o.classes) {
     const boosting::MatchConfig match = matchFor(cls);
     trainItemsOf[cls] = items;
     for (std::size_t i = 0; i < items.size(); ++i)
-      trainItemsOf[cls][i].labels = boosting::trainingLabels(items[i].labels, match);
+      trainItemsOf[cls][i].labels = boosting::trainingLabels(trainLabels[i], match);
   }
 
   // Claims, goals and charts from what is measured so far; the report is rewritten after every
@@ -541,7 +558,7 @@ int runExperiments(ExperimentOptions o) {
         config.maxStages = std::min(config.maxStages, static_cast<int>(kept));
       try {
         boosting::TrainingReport tr;
-        const boosting::Cascade c = boosting::trainOrLoad(config, trainItems, every, cache, quiet, &tr);
+        const boosting::Cascade c = boosting::trainOrLoad(config, trainItems, every, cache, o.trainLabelsKey, quiet, &tr);
         boosting::saveModel(c, o.modelsOut / (cls + ".json"),
                             {{"experiment", "all"}, {"trained_on", std::to_string(items.size()) + " frames, every drive"},
                              {"seed", std::to_string(o.seed)}, {"command", o.commandLine}});

@@ -359,7 +359,7 @@ TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
   bool cached = true;
   FoldModel first, second;
   TrainingReport report;
-  const Cascade trained = trainOrLoad(c, items, train, dir, quiet, &report, &cached, &first);
+  const Cascade trained = trainOrLoad(c, items, train, dir, "", quiet, &report, &cached, &first);
   EXPECT_FALSE(cached);
   EXPECT_FALSE(first.cached);
   EXPECT_EQ(first.key.size(), 16u);
@@ -369,7 +369,7 @@ TEST(TrainOrLoad, SecondCallLoadsTheModelAndItsRecordedTrainingTime) {
   for (const auto& [k, v] : loadModelInfo(dir / (first.key + ".json")))
     if (k == "train_seconds") recorded = std::stod(v);
   ASSERT_GE(recorded, 0);
-  const Cascade loaded = trainOrLoad(c, items, train, dir, quiet, nullptr, &cached, &second);
+  const Cascade loaded = trainOrLoad(c, items, train, dir, "", quiet, nullptr, &cached, &second);
   EXPECT_TRUE(cached);
   EXPECT_TRUE(second.cached);
   EXPECT_EQ(second.key, first.key);

@@ -2,6 +2,7 @@
 #include "fusedet/experiments/cross_validation.h"
 
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -16,6 +17,20 @@ std::string joined(const std::vector<std::string>& v) {
   for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
   return s;
 }
+
+// FNV-1a 64 over strings, each followed by a separator byte (so "ab","c" differs from "a","bc").
+struct Fnv {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  void add(const std::string& s) {
+    for (unsigned char ch : s) h = (h ^ ch) * 0x100000001b3ull;
+    h = (h ^ 0xffu) * 0x100000001b3ull;
+  }
+  std::string hex() const {
+    char buf[17];
+    std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+    return buf;
+  }
+};
 
 }  // namespace
 
@@ -41,22 +56,35 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
   return d.str();
 }
 
-std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  const auto add = [&](const std::string& s) {
-    for (unsigned char ch : s) h = (h ^ ch) * 0x100000001b3ull;
-    h = (h ^ 0xffu) * 0x100000001b3ull;  // separator
-  };
-  add(describeTrainingConfig(config));
-  for (const std::string& id : itemIds) add(id);
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
+std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds,
+                        const std::string& trainingLabels) {
+  Fnv h;
+  h.add(describeTrainingConfig(config));
+  for (const std::string& id : itemIds) h.add(id);
+  // Only when set: keys of models trained on the data set's own labels stay as they were.
+  if (!trainingLabels.empty()) h.add("training labels " + trainingLabels);
+  return h.hex();
+}
+
+std::string labelsKey(const std::vector<Labels>& labels) {
+  Fnv h;
+  std::ostringstream d;
+  d.precision(17);
+  for (const Labels& item : labels) {
+    d.str("");
+    d << "item " << item.size() << "\n";
+    for (const Label& l : item)
+      d << l.className << "\t" << l.sourceClass << "\t" << l.box.x << " " << l.box.y << " " << l.box.w << " "
+        << l.box.h << "\t" << l.truncation << " " << l.occlusion << " " << l.ignore << "\t" << l.origin << "\n";
+    h.add(d.str());
+  }
+  return h.hex();
 }
 
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
-                    ProgressSink& progress, TrainingReport* report, bool* fromCache, FoldModel* source) {
+                    const std::string& trainingLabels, ProgressSink& progress, TrainingReport* report,
+                    bool* fromCache, FoldModel* source) {
   std::vector<DatasetItem> subset;
   std::vector<std::string> ids;
   subset.reserve(train.size());
@@ -64,7 +92,7 @@ Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>
     subset.push_back(items.at(i));  // layers are shared cv::Mat headers, not copied pixels
     ids.push_back(items.at(i).id);
   }
-  const std::string key = trainingKey(config, ids);
+  const std::string key = trainingKey(config, ids, trainingLabels);
   const std::filesystem::path file = cacheDir.empty() ? std::filesystem::path() : cacheDir / (key + ".json");
   if (!file.empty() && std::filesystem::exists(file)) {
     if (fromCache) *fromCache = true;
@@ -120,7 +148,7 @@ CrossValidationResult crossValidate(const ChainSpec& spec, const std::vector<Dat
         FoldModel source;
         TrainingReport report;
         const auto t0 = std::chrono::steady_clock::now();
-        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, progress, &report, &cached, &source);
+        Cascade c = trainOrLoad(part, trainingItems, fold.train, cacheDir, spec.trainingLabels, progress, &report, &cached, &source);
         out.trainSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         out.cachedFolds += cached ? 1 : 0;
         out.cachedTrainSeconds += cached ? source.trainSeconds : 0;

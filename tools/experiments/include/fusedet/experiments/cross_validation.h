@@ -23,13 +23,20 @@
 #include "fusedet/boost/evaluation.h"
 #include "fusedet/boost/miss_analysis.h"
 #include "fusedet/core/dataset.h"
+#include "fusedet/core/label.h"
 
 namespace fusedet::boosting {
 
 // Text of every setting of a training configuration that changes the model (one per line).
 std::string describeTrainingConfig(const TrainingConfig& config);
-// 16 hex digits: FNV-1a 64 of the description and the training item ids, in order.
-std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds);
+// 16 hex digits: FNV-1a 64 of the description, the training item ids in order and, when not
+// empty, `trainingLabels`: the labelsKey() of labels trained on that are not the data set's own
+// (fusedet experiments --train-labels), so a model trained on other labels is never reused.
+std::string trainingKey(const TrainingConfig& config, const std::vector<std::string>& itemIds,
+                        const std::string& trainingLabels = "");
+// 16 hex digits: FNV-1a 64 of every item's labels (class, source class, box, truncation,
+// occlusion, ignore, origin), items in order.
+std::string labelsKey(const std::vector<Labels>& labels);
 
 // Where trainOrLoad()'s model came from: its cache key, whether it was loaded from the cache, and
 // its training time - measured now, or as its file records it (0 if none), so a run from the
@@ -41,11 +48,11 @@ struct FoldModel {
 };
 
 // Trains on items[train] (or loads `cacheDir/<key>.json` when it exists; empty cacheDir = no
-// cache) and writes the model there. `fromCache` tells which; `source` gets the details. Throws
+// cache) and writes the model there; `trainingLabels` as trainingKey() takes it. `fromCache` tells which; `source` gets the details. Throws
 // what trainCascade throws (e.g. too few positives).
 Cascade trainOrLoad(const TrainingConfig& config, const std::vector<DatasetItem>& items,
                     const std::vector<std::size_t>& train, const std::filesystem::path& cacheDir,
-                    ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr,
+                    const std::string& trainingLabels, ProgressSink& progress, TrainingReport* report = nullptr, bool* fromCache = nullptr,
                     FoldModel* source = nullptr);
 
 // Outcome of one configuration over all folds.
@@ -86,6 +93,10 @@ struct ChainSpec {
   // Also explain every missed positive (miss_analysis.h) into CrossValidationResult::positives
   // (and, with scoreTrainingItems, into trainingPositives); needs a chain of one cascade.
   bool analyseMisses = false;
+  // Empty: the cascades train on the data set's own labels. Else they train on labels from
+  // another data set of the same items (trainingItems' labels; fusedet experiments --train-labels)
+  // and this is their labelsKey(): it goes into every fold model's cache key.
+  std::string trainingLabels{};
 };
 
 // Runs `spec` over the folds: per fold trains (or loads) each part, evaluates the chain on the
