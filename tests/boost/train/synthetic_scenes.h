@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fusedet/boost/cascade_trainer.h"
+#include "fusedet/boost/evaluation.h"
 #include "fusedet/core/dataset.h"
 
 namespace fusedet::synthetic {
@@ -86,6 +87,15 @@ inline boosting::TrainingConfig smallConfig() {
   c.stage.maxWeak = 20;
   c.seed = 5;
   return c;
+}
+
+// Cars of 20 px and more, no ignore rules; every window position, single-window groups kept.
+inline boosting::MatchConfig carMatch() {
+  boosting::MatchConfig match;
+  match.className = "car";
+  match.minHeight = 20;
+  match.minDetectionHeight = 0;
+  return match;
 }
 
 // smallConfig() on both layers the hue scenes have, 2 stages, one thread: the quick training

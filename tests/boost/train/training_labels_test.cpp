@@ -53,14 +53,6 @@ std::size_t detections(const CrossValidationResult& r) {
   return n;
 }
 
-MatchConfig carMatch() {
-  MatchConfig match;
-  match.className = "car";
-  match.minHeight = 20;
-  match.minDetectionHeight = 0;
-  return match;
-}
-
 TEST(TrainingLabels, CacheKeepsModelsOfOtherTrainingLabelsApart) {
   const std::vector<DatasetItem> items = twoDrives();
   const std::vector<DatasetItem> taught = swapped(items);
@@ -74,7 +66,7 @@ TEST(TrainingLabels, CacheKeepsModelsOfOtherTrainingLabelsApart) {
   setup.scan.scaleFactor = 1.1;
   setup.scan.step = 1;
   setup.group.minNeighbors = 1;
-  const MatchConfig match = carMatch();
+  const MatchConfig match = synthetic::carMatch();
   const fs::path dir = fs::temp_directory_path() / ("fusedet_train_labels_cache_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   NullProgress quiet;

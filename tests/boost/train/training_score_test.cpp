@@ -50,15 +50,6 @@ std::vector<DatasetItem> twoDrives() {
   return items;
 }
 
-// Cars of 20 px and more, no ignore rules; every window position, single-window groups kept.
-MatchConfig carMatch() {
-  MatchConfig match;
-  match.className = "car";
-  match.minHeight = 20;
-  match.minDetectionHeight = 0;
-  return match;
-}
-
 DetectionSetup fineSetup() {
   DetectionSetup setup;
   setup.scan.scaleFactor = 1.1;
@@ -92,7 +83,7 @@ TEST(TrainingScore, EachFoldScoredOnItsOwnTrainingItems) {
   const std::vector<DatasetItem> items = twoDrives();
   const std::vector<Fold> folds = foldsOf(items);  // tests "empty", then "full"
   ASSERT_EQ(folds.size(), 2u);
-  const MatchConfig match = carMatch();
+  const MatchConfig match = synthetic::carMatch();
   const DetectionSetup setup = fineSetup();
   const TrainingConfig config = oneThreadConfig();
   ChainSpec spec{{config}};
@@ -147,7 +138,7 @@ TEST(TrainingScore, MissAnalysisOfTheOwnTrainingItems) {
   std::vector<Fold> folds = foldsOf(items);  // fold 0 trains on "full", tests "empty"
   ASSERT_EQ(folds.size(), 2u);
   std::swap(folds[0], folds[1]);  // the untrainable fold first: its outcomes must come first too
-  const MatchConfig match = carMatch();
+  const MatchConfig match = synthetic::carMatch();
   const DetectionSetup setup = fineSetup();
   const TrainingConfig config = oneThreadConfig();
   ChainSpec spec{{config}};
@@ -199,7 +190,7 @@ TEST(TrainingScore, LearningCurvePointScoresThePointsTrainingItemsOnly) {
   const std::vector<DatasetItem> items = twoDrives();
   const std::vector<Fold> folds = foldsOf(items);  // fold 0 trains on "full" (10 scenes, 20 cars)
   ASSERT_EQ(folds.size(), 2u);
-  const MatchConfig match = carMatch();
+  const MatchConfig match = synthetic::carMatch();
   const DetectionSetup setup = fineSetup();
   const TrainingConfig config = oneThreadConfig();
   std::vector<Labels> labels;
