@@ -10,6 +10,10 @@
 // (live.listen on loopback, docs/live-view.md) and that many WebSocket viewers subscribed to
 // every channel and reading as fast as they can (live_viewers.h): the latency table with 0, 1 and
 // 5 viewers beside the run without the live view.
+// --neural darknet,yolov5-onnx: after that, the same replay once per network kind with neural
+// layers on (config section neural: Yolo-Fastest-XL or YOLOv5n at 832x256 from --networks, on the
+// pipeline's network thread), beside the run without them: latency, the network's time per stack,
+// and the stacks its queue dropped (live pacing: a network slower than the sweeps drops the oldest).
 
 #include <unistd.h>
 
@@ -61,8 +65,16 @@ struct Run {
   int viewersDropped = 0;
 };
 
+// CPU ms of the run's threads called `name`.
+double threadCpuOf(const Run& r, const std::string& name) {
+  double ms = 0;
+  for (const ThreadCpu& t : r.threadCpu)
+    if (t.name == name) ms += t.cpuMs;
+  return ms;
+}
+
 // One service replaying the log `passes` times, a socket client measuring; viewers >= 0: the
-// live view on with that many viewers.
+// live view on with that many viewers; config.neural as given.
 Run replay(Config config, int passes, int viewers) {
   Run run;
   auto& latency = run.latency;
@@ -74,6 +86,7 @@ Run replay(Config config, int passes, int viewers) {
     config.live.listen = "127.0.0.1:0";
     config.socket.path += "." + std::to_string(viewers);
   }
+  if (config.neural.enabled) config.socket.path += ".neural-" + config.neural.kind;
   ServiceParts parts = replayParts(config, {});
   parts.listener = bindUnixSocket(config.socket.path);
   Service service(std::move(parts));
@@ -93,7 +106,8 @@ Run replay(Config config, int passes, int viewers) {
     const auto m = nlohmann::json::parse(*line);
     if (m["type"] != "detections") continue;
     latency.push_back(static_cast<double>(received.ns - m["sensor_ns"].get<std::int64_t>()) * 1e-6);
-    compute.push_back(m["fuse_ms"].get<double>() + m["detect_ms"].get<double>());
+    // The stack's own work on its way: fusion, the network (0 without one), detection.
+    compute.push_back(m["fuse_ms"].get<double>() + m["stages_ms"].value("neural", 0.0) + m["detect_ms"].get<double>());
     for (const auto& [stage, ms] : m["stages_ms"].items()) stages[stage].push_back(ms.get<double>());
     deliver.push_back(static_cast<double>(received.ns - m["detected_ns"].get<std::int64_t>()) * 1e-6);
     char row[200];
@@ -130,6 +144,8 @@ int main(int argc, char** argv) {
   double speed = 1.0;
   bool closeOnScan = false;
   std::vector<int> viewerCounts;
+  std::vector<std::string> neuralKinds;
+  std::string networks = FUSEDET_NETWORKS_DIR;
   app.add_option("--data", data, "root of the shared data (the log is made from its kitti/ folder)")->capture_default_str();
   app.add_option("--models", models, "folder with car.json, bike.json, person.json")->capture_default_str();
   app.add_option("--log", log, "replay this sensor log instead of synthesising one");
@@ -144,6 +160,16 @@ int main(int argc, char** argv) {
                  "after the run without the live view, one run per count with the live view on and that many "
                  "viewers subscribed to every channel, e.g. --viewers 0,1,5")
       ->delimiter(',');
+  app.add_option("--neural", neuralKinds,
+                 "after the runs above, one run per network kind with neural layers on (config section neural, input\n"
+                 "832x256, the kind's default files in --networks): darknet (Yolo-Fastest-XL), yolov5-onnx (YOLOv5n),\n"
+                 "e.g. --neural darknet,yolov5-onnx")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"darknet", "yolov5-onnx"}));
+  app.add_option("--networks", networks,
+                 "folder with yolo-fastest-1.1-xl.cfg + .weights and yolov5n_256x832.onnx (YOLOv5n is AGPL-3.0:\n"
+                 "user-supplied, never bundled)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   const std::string loadAtStart = loadAverage();
 
@@ -182,6 +208,21 @@ int main(int argc, char** argv) {
   const std::vector<ThreadCpu>& threadCpu = run.threadCpu;
   std::vector<std::pair<int, Run>> withViewers;
   for (int n : viewerCounts) withViewers.emplace_back(n, replay(config, passes, n));
+  std::vector<std::pair<std::string, Run>> withNeural;
+  for (const std::string& kind : neuralKinds) {
+    Config neural = config;
+    neural.neural.enabled = true;
+    neural.neural.kind = kind;
+    neural.neural.directory = networks;
+    neural.neural.input = "832x256";
+    try {
+      withNeural.emplace_back(kind, replay(neural, passes, -1));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "bench_daemon_latency: --neural %s: %s\n", kind.c_str(), e.what());
+      fs::remove_all(tmp);
+      return 1;
+    }
+  }
   fs::remove_all(tmp);
 
   std::printf("daemon latency, replay: %s; %d passes at %.2fx recorded speed, re-stamped; classes car bike person, "
@@ -196,6 +237,12 @@ int main(int argc, char** argv) {
               latency.size(), static_cast<unsigned long long>(c.stackQueue.dropped),
               static_cast<unsigned long long>(c.unpaired), static_cast<unsigned long long>(c.sweeps.sweeps),
               static_cast<unsigned long long>(c.sweeps.sweepsClosedOnTilt));
+  for (const auto& [kind, r] : withNeural)
+    if (r.latency.empty()) {
+      std::fprintf(stderr, "bench_daemon_latency: with neural layers (%s) no stack reached the client: %s\n", kind.c_str(),
+                   r.status.dump().c_str());
+      return 1;
+    }
   for (const auto& [n, r] : withViewers)
     if (r.latency.empty()) {
       std::fprintf(stderr, "bench_daemon_latency: with %d viewers no stack reached the client: %s\n", n, r.status.dump().c_str());
@@ -240,9 +287,7 @@ int main(int argc, char** argv) {
     auto tableRow = [](const std::string& what, const Run& r) {
       const nlohmann::json& l = r.status["live"];
       const double viewersMb = static_cast<double>(r.viewerBytes) / 1e6 / std::max(r.seconds, 1e-9);
-      double liveCpu = 0;
-      for (const ThreadCpu& t : r.threadCpu)
-        if (t.name == "fd-live") liveCpu += t.cpuMs;
+      const double liveCpu = threadCpuOf(r, "fd-live");
       std::printf("  %-22s %7zu %8.1f %8.1f %8.1f %8.1f %7llu %7llu %9.1f %9.2f %7d %8.0f\n", what.c_str(), r.latency.size(),
                   percentile(r.latency, 0.5), percentile(r.latency, 0.9), percentile(r.latency, 0.99), percentile(r.latency, 1.0),
                   static_cast<unsigned long long>(r.counters.stackQueue.dropped),
@@ -258,6 +303,37 @@ int main(int argc, char** argv) {
       if (r.latency.empty()) continue;
       std::printf("bench: live_%d_viewers_latency_p50_ms %.1f\n", n, percentile(r.latency, 0.5));
       std::printf("bench: live_%d_viewers_latency_p99_ms %.1f\n", n, percentile(r.latency, 0.99));
+    }
+  }
+  if (!withNeural.empty()) {
+    std::printf("neural layers (config section neural, 832x256, the network on its own thread fd-network, 1 OpenCV thread):\n");
+    std::printf("  %-30s %7s %8s %8s %8s %8s %7s %7s %8s %8s %8s %9s\n", "run", "stacks", "p50", "p90", "p99", "max", "q-drop",
+                "n-drop", "net p50", "net p99", "net cpu", "fd-network");
+    auto neuralRow = [](const std::string& what, const Run& r) {
+      const auto& st = r.stages;
+      const auto stage = [&](const char* k) { return st.count(k) ? st.at(k) : std::vector<double>{}; };
+      const double networkCpu = threadCpuOf(r, "fd-network");
+      std::printf("  %-30s %7zu %8.1f %8.1f %8.1f %8.1f %7llu %7llu %8.1f %8.1f %8.1f %9.0f\n", what.c_str(), r.latency.size(),
+                  percentile(r.latency, 0.5), percentile(r.latency, 0.9), percentile(r.latency, 0.99), percentile(r.latency, 1.0),
+                  static_cast<unsigned long long>(r.counters.stackQueue.dropped),
+                  static_cast<unsigned long long>(r.counters.networkQueue.dropped), percentile(stage("neural"), 0.5),
+                  percentile(stage("neural"), 0.99), percentile(stage("neural_cpu"), 0.5), networkCpu);
+    };
+    neuralRow("no neural layers", run);
+    for (const auto& [kind, r] : withNeural)
+      neuralRow(kind == "darknet" ? "Yolo-Fastest-XL (darknet)" : "YOLOv5n (yolov5-onnx)", r);
+    std::printf("  (ms: sensor stamp -> socket client; q-drop: stacks the stack queue dropped; n-drop: stacks the network queue\n"
+                "  dropped, never run through the network; net: the network's run + score layers per stack, wall, and the\n"
+                "  network thread's CPU ms (p50); fd-network: that thread's CPU ms over the run)\n");
+    for (const auto& [kind, r] : withNeural) {
+      const std::string key = kind == "darknet" ? "darknet" : "yolov5n";
+      const auto neuralMs = r.stages.count("neural") ? r.stages.at("neural") : std::vector<double>{};
+      std::printf("bench: neural_%s_latency_p50_ms %.1f\n", key.c_str(), percentile(r.latency, 0.5));
+      std::printf("bench: neural_%s_latency_p99_ms %.1f\n", key.c_str(), percentile(r.latency, 0.99));
+      std::printf("bench: neural_%s_network_p50_ms %.1f\n", key.c_str(), percentile(neuralMs, 0.5));
+      std::printf("bench: neural_%s_network_queue_dropped %llu\n", key.c_str(),
+                  static_cast<unsigned long long>(r.counters.networkQueue.dropped));
+      std::printf("bench: neural_%s_stacks %zu\n", key.c_str(), r.latency.size());
     }
   }
   std::printf("bench: compute_p50_ms %.1f\n", percentile(compute, 0.5));

@@ -19,9 +19,18 @@
 // window scan (the vector stage loops) and the rest (grouping). The 2-thread run reports wall time
 // (its work is split over two threads) and the scaling against one thread.
 //
+// With neural layers (issue 30; --networks, default ../shared/models): in the same rounds, each
+// network (Yolo-Fastest-XL, Darknet, 832x256; YOLOv5n, ONNX, 832x256) run once on the stack's
+// camera image with its score layers added (fusion::NeuralLayers::add, what fusedetd's network
+// thread does per stack), one OpenCV thread; and the stack's whole cost with them: that plus
+// fusedetd's path on the stack that has the network's layers (the bundled models do not read them:
+// a model trained on them scans the same windows).
+//
 // Headline: bench: detect3_ms, bench: detect3_daemon_path_ms (detectPerClass, the path fusedetd runs),
 // bench: opencv_face_ms, bench: detect3_over_opencv_face, bench: detect3_daemon_path_over_opencv_face
-// (all on the dispatched path); per path P (avx512, avx2, scalar): detect3_P_ms, detect3_P_over_opencv_face.
+// (all on the dispatched path); per path P (avx512, avx2, scalar): detect3_P_ms, detect3_P_over_opencv_face;
+// per network N (darknet_832x256, yolov5n_832x256): neural_N_ms (the network and its layers),
+// detect3_daemon_path_plus_neural_N_ms.
 
 #include <algorithm>
 #include <chrono>
@@ -30,11 +39,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <memory>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/objdetect.hpp>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -47,7 +58,9 @@
 #include "fusedet/boost/vector_path.h"
 #include "fusedet/boost/window_scanner.h"
 #include "fusedet/core/cpu_time.h"
+#include "fusedet/fusion/camera_layers.h"
 #include "fusedet/fusion/datasets/kitti.h"
+#include "fusedet/fusion/neural/neural_layers.h"
 
 namespace {
 
@@ -89,6 +102,7 @@ struct Args {
   int rounds = 15;
   fs::path data = FUSEDET_DATA_DIR;
   fs::path models = FUSEDET_MODELS_DIR;
+  fs::path networks = FUSEDET_NETWORKS_DIR;
   std::string drive = "kitti";
 };
 
@@ -106,6 +120,11 @@ Args parse(int argc, char** argv) {
   app.add_option("--data", a.data, "root of the shared data")->capture_default_str();
   app.add_option("--drive", a.drive, "KITTI drive folder under --data")->capture_default_str();
   app.add_option("--models", a.models, "folder with car.json, person.json, bike.json")->capture_default_str();
+  app.add_option("--networks", a.networks,
+                 "folder with the networks of the neural rows: yolo-fastest-1.1-xl.cfg and .weights (Darknet) and\n"
+                 "yolov5n_256x832.onnx (YOLOv5n, AGPL-3.0: user-supplied); a network whose files are not there\n"
+                 "gets no rows (the reason is printed); empty: no neural rows")
+      ->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -187,6 +206,31 @@ int main(int argc, char** argv) try {
                 eq ? "identical" : "DIFFERENT");
   }
 
+  // The networks of the neural rows, each with the stack it makes (the demo stack + its layers).
+  struct NeuralRow {
+    std::string key, what;
+    std::unique_ptr<fusion::NeuralLayers> layers;
+    LayerStack stack;
+    Timing run, detect;
+    std::size_t found = 0;
+  };
+  std::vector<NeuralRow> neural;
+  const cv::Mat cameraBgr = fusion::cameraImage(stack);
+  if (!a.networks.empty())
+    for (const auto& [kind, key, what] : {std::tuple{fusion::NetworkKind::darknet, "darknet_832x256", "Yolo-Fastest-XL (Darknet) 832x256"},
+                                         std::tuple{fusion::NetworkKind::yolov5Onnx, "yolov5n_832x256", "YOLOv5n (ONNX) 832x256"}}) {
+      fusion::NeuralLayerOptions o;
+      o.kind = kind;
+      o.directory = a.networks;
+      try {
+        NeuralRow row{key, what, std::make_unique<fusion::NeuralLayers>(o), stack, {}, {}, 0};
+        row.layers->add(row.stack, cameraBgr);
+        neural.push_back(std::move(row));
+      } catch (const std::exception& e) {
+        std::printf("neural rows of %s: none (%s)\n", what, e.what());
+      }
+    }
+
   Timing ours, ours2, previous, opencv, daemonPath, integrals;
   std::vector<Timing> pathTotal(paths.size()), pathScan(paths.size());
   std::size_t found = 0, foundPrev = 0, faces = 0, foundDaemonPath = 0;
@@ -216,6 +260,11 @@ int main(int argc, char** argv) try {
     ScanParams two = scan;
     two.threads = 2;
     ours2.add([&] { (void)detect(all, stack, two, group); });
+    for (NeuralRow& n : neural) {
+      LayerStack withLayers = stack;
+      n.run.add([&] { n.layers->add(withLayers, cameraBgr); });
+      n.detect.add([&] { n.found = detectPerClass(all, n.stack, scan, group, noExtent, perClass).size(); });
+    }
   }
   const double d3 = median(ours.cpu), cvf = median(opencv.cpu), prev = median(previous.cpu),
                d3k = median(daemonPath.cpu);
@@ -240,6 +289,13 @@ int main(int argc, char** argv) try {
   std::printf("  ours, 2 threads: wall %.2f ms (min %.2f), process CPU %.2f ms; scaling vs 1 thread (wall) %.2fx\n",
               median(ours2.wall), minimum(ours2.wall), median(ours2.processCpu),
               median(ours2.wall) > 0 ? median(ours.wall) / median(ours2.wall) : 0.0);
+  for (const NeuralRow& n : neural) {
+    const double net = median(n.run.cpu), det = median(n.detect.cpu);
+    std::printf("  neural layers, %-34s %8.2f (%7.2f) / %8.2f  -> the network on the %dx%d image + 3 score layers, 1 OpenCV thread\n",
+                (n.what + ":").c_str(), net, minimum(n.run.cpu), median(n.run.wall), cameraBgr.cols, cameraBgr.rows);
+    std::printf("  fusedetd's path on that stack + the network: %8.2f / %8.2f  -> %zu detections (%zu layers; %.3f x OpenCV)\n",
+                det + net, median(n.detect.wall) + median(n.run.wall), n.found, n.stack.size(), cvf > 0 ? (det + net) / cvf : 0.0);
+  }
   std::printf("equal terms: every contender on the same fused stack in the same process, rounds interleaved, one\n"
               "thread each (cv::setNumThreads(1)), thread CPU time; the per-class path scans the same models with the\n"
               "same scales, step and grouping (its hits checked identical above); OpenCV runs frontalface_default on\n"
@@ -266,6 +322,10 @@ int main(int argc, char** argv) try {
   std::printf("bench: opencv_face_ms %.3f\n", cvf);
   std::printf("bench: detect3_over_opencv_face %.3f\n", cvf > 0 ? d3 / cvf : 0.0);
   std::printf("bench: detect3_daemon_path_over_opencv_face %.3f\n", cvf > 0 ? d3k / cvf : 0.0);
+  for (const NeuralRow& n : neural) {
+    std::printf("bench: neural_%s_ms %.3f\n", n.key.c_str(), median(n.run.cpu));
+    std::printf("bench: detect3_daemon_path_plus_neural_%s_ms %.3f\n", n.key.c_str(), median(n.detect.cpu) + median(n.run.cpu));
+  }
   return same == models.size() ? 0 : 1;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "bench_detect3: error: %s\n", e.what());

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <opencv2/core/utility.hpp>
 
 #include "fusedet/core/cpu_time.h"
 #include "fusedet/fusion/frame_decode.h"
@@ -19,6 +20,8 @@ Pipeline::Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> det
       detector_(std::move(detector)),
       sensorQueue_(setup_.sensorQueueCapacity, setup_.sensorQueueBytes, &Pipeline::bytesOf),
       stackQueue_(setup_.stackQueueCapacity),
+      hasNetwork_(setup_.fuser && setup_.fuser->neural()),
+      networkQueue_(std::max<std::size_t>(1, setup_.networkQueueCapacity)),
       assembler_(setup_.sweep),
       pairer_(setup_.maxPairSkewNs, 32, setup_.pairerBytes),
       tracker_(setup_.tracking) {
@@ -47,19 +50,27 @@ void Pipeline::start() {
   const std::int64_t now = Stamp::now().ns;
   fusionBeat_ = now;
   detectionBeat_ = now;
+  if (hasNetwork_) {
+    networkBeat_ = now;
+    cv::setNumThreads(setup_.fuser->neural()->threads());
+    networkThread_ = std::thread([this] { networkLoop(); });
+  }
   fusionThread_ = std::thread([this] { fusionLoop(); });
   detectionThread_ = std::thread([this] { detectionLoop(); });
 }
 
 void Pipeline::stop(std::chrono::steady_clock::time_point deadline) {
-  // Fusion drains the closed sensor queue and then closes the stack queue; detection ends when
-  // that is empty. Whatever is still queued at the deadline is abandoned.
+  // Fusion drains the closed sensor queue and then closes the next queue (the network's, else
+  // the stack queue); the network thread drains its queue and closes the stack queue; detection
+  // ends when that is empty. Whatever is still queued at the deadline is abandoned.
   sensorQueue_.close();
   while (detectionThread_.joinable() && !detectionDone_ && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   abandon_ = true;
+  networkQueue_.close();
   stackQueue_.close();
   if (fusionThread_.joinable()) fusionThread_.join();
+  if (networkThread_.joinable()) networkThread_.join();
   if (detectionThread_.joinable()) detectionThread_.join();
 }
 
@@ -103,7 +114,8 @@ void Pipeline::awaitRoom(const std::atomic<bool>& stop) {
 bool Pipeline::idle() const {
   const PipelineCounters c = counters();
   return c.sensorQueue.depth == 0 && c.handled == c.sensorQueue.pushed - c.sensorQueue.dropped &&
-         c.stackQueue.depth == 0 && c.stacksFused == c.stacksDetected + c.detectErrors + c.stackQueue.dropped;
+         c.networkQueue.depth == 0 && c.stackQueue.depth == 0 &&
+         c.stacksFused == c.stacksDetected + c.detectErrors + c.stackQueue.dropped + c.networkQueue.dropped;
 }
 
 void Pipeline::fusionLoop() {
@@ -125,7 +137,7 @@ void Pipeline::fusionLoop() {
     std::lock_guard lock(countersMutex_);
     ++counters_.handled;
   }
-  stackQueue_.close();
+  (hasNetwork_ ? networkQueue_ : stackQueue_).close();
 }
 
 void Pipeline::handle(SensorMessage& message) {
@@ -166,9 +178,8 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
     return;
   }
   const auto t1 = std::chrono::steady_clock::now();
-  fusion::FuseTimings fuseTimes;
-  fused.stack = setup_.fuser->fuse(bgr.value(), sweep, &fuseTimes);
-  fused.stages.neuralMs = fuseTimes.neuralMs;
+  // With a network its layers come on the network thread (networkLoop), from the undistorted image.
+  fused.stack = hasNetwork_ ? setup_.fuser->fuseSensors(bgr.value(), sweep, &fused.image) : setup_.fuser->fuse(bgr.value(), sweep);
   fused.stack.id = nextStackId_++;
   fused.stack.stamp = frame.stamp;
   fused.stack.source = "pipeline";
@@ -186,13 +197,65 @@ void Pipeline::fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFra
     ++counters_.stacksFused;
     counters_.lastFuseMs = fused.fuseMs;
   }
+  handOver(hasNetwork_ ? networkQueue_ : stackQueue_, std::move(fused), fusionBeat_);
+}
+
+bool Pipeline::handOver(BoundedQueue<FusedStack>& queue, FusedStack&& fused, std::atomic<std::int64_t>& beat) {
   if (setup_.lossless)
-    while (!stackQueue_.waitForRoom(stackQueue_.capacity() - 1, kIdleWake)) {
-      if (abandon_ || stackQueue_.closed()) return;
-      fusionBeat_ = Stamp::now().ns;  // waiting for detection is not a stall of this thread
+    while (!queue.waitForRoom(queue.capacity() - 1, kIdleWake)) {
+      if (abandon_ || queue.closed()) return false;
+      beat = Stamp::now().ns;  // waiting for the next stage is not a stall of this thread
     }
   fused.queuedAt = std::chrono::steady_clock::now();
-  stackQueue_.push(std::move(fused));
+  queue.push(std::move(fused));
+  return true;
+}
+
+void Pipeline::networkLoop() {
+  nameThisThread("fd-network");
+  while (!abandon_) {
+    networkBeat_ = Stamp::now().ns;
+    auto fused = networkQueue_.pop(kIdleWake);
+    if (!fused) {
+      if (networkQueue_.closed()) break;
+      continue;
+    }
+    runNetwork(*fused);
+    handOver(stackQueue_, std::move(*fused), networkBeat_);
+  }
+  stackQueue_.close();
+}
+
+void Pipeline::runNetwork(FusedStack& fused) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = threadCpuMs();
+  fused.stages.neuralQueueMs = std::chrono::duration<double, std::milli>(t0 - fused.queuedAt).count();
+  try {
+    setup_.fuser->addNetworkLayers(fused.stack, fused.image);
+  } catch (const std::exception& e) {
+    fused.networkError = e.what();
+  }
+  fused.image.release();
+  fused.stages.neuralMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  fused.stages.neuralCpuMs = threadCpuMs() - cpu0;
+  networkTimes_.add(fused.stages.neuralMs);
+  std::lock_guard lock(countersMutex_);
+  ++counters_.networkRuns;
+  counters_.lastNetworkMs = fused.stages.neuralMs;
+  if (!fused.networkError.empty()) {
+    ++counters_.networkErrors;
+    // The journal hears when the network starts failing and when it works again; each failure
+    // in between is counted (status), with the last error.
+    if (!counters_.networkFailing)
+      spdlog::error("stack {}: the network failed; stacks go on without its layers, and classes whose models need "
+                    "them are not detected until it works again: {}",
+                    fused.stack.id, fused.networkError);
+    counters_.networkFailing = true;
+    counters_.lastNetworkError = fused.networkError;
+  } else if (counters_.networkFailing) {
+    spdlog::info("stack {}: the network works again ({} failed runs so far)", fused.stack.id, counters_.networkErrors);
+    counters_.networkFailing = false;
+  }
 }
 
 void Pipeline::detectionLoop() {
@@ -222,7 +285,15 @@ void Pipeline::detectionLoop() {
     result->stages.queueMs = std::chrono::duration<double, std::milli>(t0 - fused->queuedAt).count();
     try {
       const double cpu0 = threadCpuMs();
-      std::vector<Detection> found = detector->detect(fused->stack);
+      // Without the network's layers (its run failed) only the models that do not need them run.
+      std::vector<Detection> found;
+      if (fused->networkError.empty()) {
+        found = detector->detect(fused->stack);
+      } else {
+        found = detector->detectWithoutNetwork(fused->stack);
+        result->networkError = fused->networkError;
+        result->classesNotRun = detector->networkClasses();
+      }
       result->stages.detectCpuMs = threadCpuMs() - cpu0;
       const auto t1 = std::chrono::steady_clock::now();
       result->stages.detectMs = std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -282,6 +353,11 @@ PipelineCounters Pipeline::counters() const {
   }
   c.sensorQueue = sensorQueue_.counters();
   c.stackQueue = stackQueue_.counters();
+  c.network = hasNetwork_;
+  if (hasNetwork_) {
+    c.networkQueue = networkQueue_.counters();
+    c.networkMs = networkTimes_.summary();
+  }
   const std::int64_t now = Stamp::now().ns;
   c.scanRate = scanRate_.rate(now);
   c.tiltRate = tiltRate_.rate(now);

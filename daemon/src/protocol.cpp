@@ -102,7 +102,7 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
     }
     dets.push_back(std::move(j));
   }
-  return {{"type", type},
+  nlohmann::json line{{"type", type},
           {"stack", r.stackId},
           {"sweep_start_ns", r.sweepStart.ns},
           {"sweep_end_ns", r.sweepEnd.ns},
@@ -114,14 +114,21 @@ nlohmann::json resultToJson(const StackResult& r, const std::set<std::string>& c
           {"stages_ms", {{"close", r.stages.closeMs},
                          {"decode", r.stages.decodeMs},
                          {"fuse", r.stages.fuseMs},
-                         {"neural", r.stages.neuralMs},
                          {"fuse_cpu", r.stages.fuseCpuMs},
+                         {"neural_queue", r.stages.neuralQueueMs},
+                         {"neural", r.stages.neuralMs},
+                         {"neural_cpu", r.stages.neuralCpuMs},
                          {"queue", r.stages.queueMs},
                          {"detect", r.stages.detectMs},
                          {"detect_cpu", r.stages.detectCpuMs},
                          {"localize", r.stages.localizeMs},
                          {"track", r.stages.trackMs}}},
           {"detections", std::move(dets)}};
+  if (!r.networkError.empty()) {
+    line["network_error"] = r.networkError;
+    line["classes_not_run"] = r.classesNotRun;
+  }
+  return line;
 }
 
 nlohmann::json tracksToJson(const StackResult& r, const std::set<std::string>& classes) {

@@ -263,6 +263,17 @@ nlohmann::json Service::status() const {
                 {"last_encode_ms", l.lastEncodeMs},
                 {"encoded", std::move(encoded)}};
   }
+  nlohmann::json network = nullptr;  // null: no network (config section neural off)
+  if (p.network)
+    network = {{"network", pipeline_->fuser().network().text()},
+               {"queue", {{"depth", p.networkQueue.depth}, {"pushed", p.networkQueue.pushed}, {"dropped", p.networkQueue.dropped}}},
+               {"runs", p.networkRuns},
+               {"errors", p.networkErrors},
+               {"failing", p.networkFailing},
+               {"last_error", p.lastNetworkError},
+               {"last_ms", p.lastNetworkMs},
+               {"ms", {{"samples", p.networkMs.samples}, {"p50", p.networkMs.p50Ms}, {"p90", p.networkMs.p90Ms},
+                       {"p99", p.networkMs.p99Ms}, {"max", p.networkMs.maxMs}}}};
   std::lock_guard lock(mutex_);
   return {
       {"mode", mode_},
@@ -287,7 +298,8 @@ nlohmann::json Service::status() const {
         {"stacks_detected", p.stacksDetected},
         {"detections", p.detections},
         {"last_fuse_ms", p.lastFuseMs},
-        {"last_detect_ms", p.lastDetectMs}}},
+        {"last_detect_ms", p.lastDetectMs},
+        {"network", std::move(network)}}},
       {"latency_ms", {{"samples", lat.samples}, {"p50", lat.p50Ms}, {"p90", lat.p90Ms}, {"p99", lat.p99Ms}, {"max", lat.maxMs}}},
       {"clients",
        {{"connected", s.clients},
@@ -324,8 +336,10 @@ std::string Service::stalled(std::int64_t maxAgeNs) const {
   const std::int64_t now = Stamp::now().ns;
   std::string out;
   for (const auto& [name, beat] : {std::pair{"fusion", pipeline_->fusionBeatNs()},
+                                   std::pair{"network", pipeline_->networkBeatNs()},
                                    std::pair{"detection", pipeline_->detectionBeatNs()},
                                    std::pair{"server", server_->beatNs()}}) {
+    if (std::string_view(name) == "network" && !pipeline_->hasNetworkThread()) continue;
     const std::int64_t age = now - beat;
     if (age < maxAgeNs) continue;
     const std::int64_t seconds = age / 1'000'000'000;
@@ -349,7 +363,9 @@ std::string Service::summary() const {
     }
   if (tiltMotion(p.sweeps) == std::string("still"))
     o << "; tilt still for " << static_cast<int>(p.sweeps.tiltStillS) << " s (" << p.sweeps.sweepsCut << " sweeps cut)";
-  o << "; " << p.stacksDetected << " stacks, " << p.stackQueue.dropped << " dropped; " << s.clients << " clients";
+  o << "; " << p.stacksDetected << " stacks, " << p.stackQueue.dropped + p.networkQueue.dropped << " dropped; " << s.clients
+    << " clients";
+  if (p.networkFailing) o << "; network failing (" << p.networkErrors << " failed runs): " << p.lastNetworkError;
   std::lock_guard lock(mutex_);
   if (!lastReloadError_.empty()) o << "; reload failed: " << lastReloadError_;
   return o.str();

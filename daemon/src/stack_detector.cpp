@@ -86,6 +86,11 @@ CascadeSet::CascadeSet(const Config::Detection& settings, const std::filesystem:
     files_.push_back(file);
   }
   try {
+    std::vector<boosting::Cascade> plain;
+    for (const boosting::Cascade& c : cascades)
+      if (!usesNetworkLayers(c.layers)) plain.push_back(c);
+    if (plain.size() < cascades.size() && !plain.empty())
+      withoutNetwork_ = std::make_unique<boosting::MultiDetector>(std::move(plain));
     detector_ = std::make_unique<boosting::MultiDetector>(std::move(cascades));
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(std::string("detection.models: ") + e.what());
@@ -108,6 +113,19 @@ std::vector<std::string> CascadeSet::unmatchedClassSettings() const {
 
 std::vector<Detection> CascadeSet::detect(const LayerStack& stack) const {
   return boosting::detectPerClass(*detector_, stack, scan_, group_, extent_, perClass_);
+}
+
+std::vector<Detection> CascadeSet::detectWithoutNetwork(const LayerStack& stack) const {
+  if (networkClasses().empty()) return detect(stack);
+  if (!withoutNetwork_) return {};
+  return boosting::detectPerClass(*withoutNetwork_, stack, scan_, group_, extent_, perClass_);
+}
+
+std::vector<std::string> CascadeSet::networkClasses() const {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < detector_->size(); ++i)
+    if (usesNetworkLayers(detector_->cascade(i).layers)) names.push_back(detector_->cascade(i).className);
+  return names;
 }
 
 std::vector<std::string> CascadeSet::classes() const {

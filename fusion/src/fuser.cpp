@@ -39,10 +39,21 @@ std::vector<std::string> Fuser::stackLayers() const {
 }
 
 LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings) const {
+  const auto start = Clock::now();
+  FuseTimings t;
+  cv::Mat image;
+  LayerStack stack = fuseSensors(bgr, sweep, &image, &t);
+  addNetworkLayers(stack, image, &t);
+  t.totalMs = msSince(start);
+  if (timings) *timings = t;
+  return stack;
+}
+
+LayerStack Fuser::fuseSensors(const cv::Mat& bgr, const Sweep& sweep, cv::Mat* undistorted, FuseTimings* timings) const {
   FuseTimings t;
   const auto start = Clock::now();
   auto t0 = start;
-  const cv::Mat image = undistorter_.undistort(bgr);
+  cv::Mat image = undistorter_.undistort(bgr);
   t.undistortMs = msSince(t0);
 
   t0 = Clock::now();
@@ -59,15 +70,17 @@ LayerStack Fuser::fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timi
   stack.set(std::move(laser.distance));
   stack.set(std::move(laser.remission));
   t.rasteriseMs = msSince(t0);
-
-  if (neural_) {
-    t0 = Clock::now();
-    neural_->add(stack, image);
-    t.neuralMs = msSince(t0);
-  }
   t.totalMs = msSince(start);
+  if (undistorted) *undistorted = std::move(image);
   if (timings) *timings = t;
   return stack;
+}
+
+void Fuser::addNetworkLayers(LayerStack& stack, const cv::Mat& undistorted, FuseTimings* timings) const {
+  if (!neural_) return;
+  const auto t0 = Clock::now();
+  neural_->add(stack, undistorted);
+  if (timings) timings->neuralMs = msSince(t0);
 }
 
 }  // namespace fusedet::fusion

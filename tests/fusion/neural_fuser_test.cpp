@@ -3,11 +3,13 @@
 // frame imported with Yolo-Fastest-XL gets the score layers a direct run of the same network on the
 // frame gives (cell for cell) and the network's record; without a network the stack is as before;
 // the layers from a stored stack's camera layers (fusedet detect's path) equal the import's; the
-// data set keeps them and the record; a missing network file is named.
+// data set keeps them and the record; a missing network file is named; fuse() in two steps (the
+// daemon's network thread) is fuse(); a failed run adds nothing and names the network and why.
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <unistd.h>
@@ -104,6 +106,62 @@ TEST(NeuralFuser, MissingOrWrongNetworkIsNamed) {
   o = darknetOptions();
   o.files = {"yolo-fastest-1.1-xl.cfg", kModels / "yolo-fastest-1.1-xl.weights"};  // relative: in the folder
   EXPECT_EQ(networkSpecFor(o).files, defaultNetworkFiles(NetworkKind::darknet, kModels));
+}
+
+// fuse() in two steps (fusedetd's pipeline: the network on its own thread) gives the same stack.
+TEST(NeuralFuser, FuseSensorsThenNetworkLayersIsFuse) {
+  const KittiFrame frame = readKittiFrame(kKitti, "000000");
+  const auto neural = std::make_shared<const NeuralLayers>(darknetOptions());
+  const Fuser fuser = kittiFuser(frame.calib, frame.image.cols, frame.image.rows, {}, neural);
+  const Sweep& sweep = frame.points;
+  const LayerStack whole = fuser.fuse(frame.image, sweep);
+  cv::Mat undistorted;
+  LayerStack split = fuser.fuseSensors(frame.image, sweep, &undistorted);
+  EXPECT_EQ(split.names(), Fuser::layerNames());
+  EXPECT_TRUE(split.network.empty());
+  fuser.addNetworkLayers(split, undistorted);
+  ASSERT_EQ(split.names(), whole.names());
+  for (const std::string& n : whole.names())
+    EXPECT_EQ(cv::norm(split.at(n).data, whole.at(n).data, cv::NORM_INF), 0.0) << n;
+  EXPECT_EQ(split.network, whole.network);
+}
+
+// A run that fails adds nothing and names the network and the problem: cv::dnn throwing, an
+// output of another shape, a score that is not finite or not in [0, 1], a box that is not finite.
+TEST(NeuralFuser, AFailedRunAddsNothingAndSaysWhy) {
+  const KittiFrame frame = readKittiFrame(kKitti, "000000");
+  const Network reference(networkSpecFor(darknetOptions()));
+  const std::string identity = reference.identity().text();
+  int mode = 0;
+  const NeuralLayers layers(darknetOptions(), [&mode](Network& n, const cv::Mat& bgr) {
+    if (mode == 1) CV_Error(cv::Error::StsBadSize, "injected blob size");
+    Anchors a = n.run(bgr);
+    if (mode == 2) a.scores = a.scores.colRange(0, 3).clone();
+    if (mode == 3) a.scores.at<float>(7, 2) = std::numeric_limits<float>::quiet_NaN();
+    if (mode == 4) a.scores.at<float>(7, 2) = 1.5f;
+    if (mode == 5) a.boxes[3].w = std::numeric_limits<double>::infinity();
+    return a;
+  });
+  const auto failure = [&](int m) {
+    mode = m;
+    LayerStack stack(frame.image.cols, frame.image.rows);
+    try {
+      layers.add(stack, frame.image);
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(stack.size(), 0u) << "nothing added";
+      EXPECT_TRUE(stack.network.empty());
+      return std::string(e.what());
+    }
+    return std::string("(added ") + std::to_string(stack.size()) + " layers)";
+  };
+  EXPECT_EQ(failure(0), "(added 3 layers)");
+  const std::string prefix = "network " + identity + " on a 1242x375 image: ";
+  EXPECT_EQ(failure(1).substr(0, prefix.size() + 16), prefix + "cv::dnn failed: ");
+  EXPECT_NE(failure(1).find("injected blob size"), std::string::npos);
+  EXPECT_EQ(failure(2), prefix + "output of 3120 anchor rows x 3 classes where it gave 3120 x 80 at load");
+  EXPECT_EQ(failure(3), prefix + "output of a class score that is not finite");
+  EXPECT_EQ(failure(4), prefix + "output of a class score outside [0, 1] (1.500000)");
+  EXPECT_EQ(failure(5), prefix + "output of a box that is not finite");
 }
 
 }  // namespace

@@ -147,6 +147,8 @@ Network::Network(const NetworkSpec& spec) : spec_(spec), impl_(std::make_unique<
     if (spec.kind == NetworkKind::yolov5Onnx && static_cast<int>(a.size()) != yolov5Rows(spec.input))
       throw std::invalid_argument(std::to_string(a.size()) + " output rows where a YOLOv5 at " + sizeText(spec.input) +
                                   " has " + std::to_string(yolov5Rows(spec.input)));
+    anchorRows_ = a.size();
+    classes_ = a.scores.cols;
   } catch (const std::exception& e) {
     throw std::runtime_error(spec.files.front().string() + ": not a " + kind + " detector at input size " +
                              sizeText(spec.input) + ": " + e.what());
@@ -167,16 +169,17 @@ NetworkOutput Network::forward(const cv::Mat& bgr) {
   // RGB, scaled 1/255, N x C x H x W; the image already has the input size.
   const cv::Mat blob = cv::dnn::blobFromImage(input, 1.0 / 255.0, cv::Size(), cv::Scalar(), true, false, CV_32F);
   const int previousThreads = cv::getNumThreads();
-  cv::setNumThreads(spec_.threads);
+  const bool setThreads = previousThreads != spec_.threads;
+  if (setThreads) cv::setNumThreads(spec_.threads);
   std::vector<cv::Mat> outputs;
   try {
     impl_->net.setInput(blob);
     impl_->net.forward(outputs, impl_->outputNames);
   } catch (...) {
-    cv::setNumThreads(previousThreads);
+    if (setThreads) cv::setNumThreads(previousThreads);
     throw;
   }
-  cv::setNumThreads(previousThreads);
+  if (setThreads) cv::setNumThreads(previousThreads);
   for (const cv::Mat& o : outputs) out.outputs.push_back(o.clone());
   return out;
 }

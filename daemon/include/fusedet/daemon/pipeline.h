@@ -2,17 +2,36 @@
 #pragma once
 // Pipeline: sensor messages -> sweep assembly -> pairing -> fusion (fusion thread) -> every class
 // (detection thread) -> 3D positions -> tracks (tracking::Tracker, detection thread) -> StackResult handed to a callback (the socket server). Sources run on their
-// own threads and push into the sensor queue through the SensorSink interface; both queues are
+// own threads and push into the sensor queue through the SensorSink interface; the queues are
 // bounded (the sensor queue by count and bytes) and drop their oldest item when full (counted), so no producer ever waits. When
 // detection falls behind, the stack queue (2 deep) drops the oldest stack. Lossless mode (a log
 // replayed as fast as possible) is the exception: there the source waits for room (awaitRoom)
 // and fusion for detection, so every stack is detected and a replay is deterministic.
+//
+// With a network (the fuser's NeuralLayers, config section neural) one more stage and thread
+// sits between fusion and detection: the fusion thread makes every other layer
+// (Fuser::fuseSensors) and hands the stack with its undistorted image to the network thread
+// (`fd-network`, Fuser::addNetworkLayers), which hands it on to detection. So the network's run on
+// one stack overlaps the fusion of the next sweep and the detection of the previous stack. The
+// network queue is 1 deep and drops its oldest stack (counted) like the stack queue: live, a
+// fresher stack is worth more than an older one, and waiting instead would stall fusion until
+// the sensor queue drops raw scans and frames, which breaks sweeps instead of skipping a whole
+// one; in lossless mode fusion waits for the network thread instead. The stacks pass the network
+// one at a time, in order, through the same calls fuse() makes, so the layers and detections are
+// those of running the network inline. Without a network there is no such thread or queue.
+//
+// A network run that fails (cv::dnn throws, an output of another shape: NeuralLayers::add) does
+// not drop the stack: it goes on without the network's layers, the classes whose models need them
+// are not run on it and the result names them and the error (StackResult::networkError,
+// classesNotRun); `status` counts the failures and shows the last error, and the journal says
+// when the network starts failing and when it works again.
 
 #include <atomic>
 #include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <string>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -46,8 +65,11 @@ struct StageTimes {
                            // pairing, the sensor queue
   double decodeMs = 0;     // camera frame -> BGR image
   double fuseMs = 0;       // Fuser::fuse: undistortion, camera layers, projection, laser layers
-  double neuralMs = 0;     // of fuseMs: the network's score layers (config section neural; 0 when off)
   double fuseCpuMs = 0;    // the fusion thread's CPU time for decode + fuse
+  // The network (config section neural; all 0 when off), on the network thread:
+  double neuralQueueMs = 0;  // in the network queue, waiting for the network thread
+  double neuralMs = 0;       // the network's run and its score layers (Fuser::addNetworkLayers)
+  double neuralCpuMs = 0;    // the network thread's CPU time for it (OpenCV's helper threads not counted)
   double queueMs = 0;      // in the stack queue, waiting for the detection thread
   double detectMs = 0;     // every class: integrals, window scan, grouping
   double detectCpuMs = 0;  // the detection thread's CPU time for it (helper threads not counted)
@@ -73,6 +95,10 @@ struct StackResult {
   double fuseMs = 0, detectMs = 0;  // detectMs: detection + localisation
   StageTimes stages;
   std::vector<LocatedDetection> detections;
+  // The network failed on this stack (its error; empty when it ran or there is none): the
+  // classes whose models need its layers were not run (classesNotRun) and have no detections.
+  std::string networkError;
+  std::vector<std::string> classesNotRun;
   // Every live track after this stack (tentative, confirmed, coasting), ascending id.
   std::vector<tracking::TrackState> tracks;
   std::shared_ptr<const StackView> view;  // with PipelineSetup::keepViews, else empty
@@ -86,6 +112,7 @@ struct PipelineSetup {
   std::size_t sensorQueueBytes = 64u << 20;  // and their bytes: ~16 1080p YUYV frames (512 would be 2 GB)
   std::size_t pairerBytes = 64u << 20;      // camera frames waiting for their sweep (fusion::FramePairer)
   std::size_t stackQueueCapacity = 2;     // fused stacks waiting for detection
+  std::size_t networkQueueCapacity = 1;   // fused stacks waiting for the network (with one)
   // Fusion waits for room in the stack queue instead of dropping the oldest stack. Only for
   // sources that can wait too (a log replayed as fast as possible), never for live devices.
   bool lossless = false;
@@ -97,6 +124,16 @@ struct PipelineSetup {
 
 struct PipelineCounters {
   QueueCounters sensorQueue, stackQueue;  // stackQueue.dropped = stacks detection never saw
+  // The network stage (zero when the fuser has no network): networkQueue.dropped = stacks the
+  // network never saw; the network's per-stack wall time (its run and score layers) over the
+  // last 1024 stacks; failed runs, the last one's error, and whether the last run failed.
+  bool network = false;
+  QueueCounters networkQueue;
+  std::uint64_t networkRuns = 0, networkErrors = 0;
+  LatencySummary networkMs;
+  double lastNetworkMs = 0;
+  bool networkFailing = false;
+  std::string lastNetworkError;
   fusion::SweepStats sweeps;
   std::uint64_t scenes = 0;         // pre-paired scenes received
   std::uint64_t handled = 0;        // sensor-queue messages the fusion thread finished with
@@ -122,6 +159,9 @@ class Pipeline : public SensorSink {
   Pipeline(const Pipeline&) = delete;
   Pipeline& operator=(const Pipeline&) = delete;
 
+  // Starts the threads. With a network, first sets OpenCV's process-wide thread count to the
+  // network's (neural.threads) once, so that no run changes it while fusion uses OpenCV
+  // (network.h, Determinism).
   void start();
   // Refuses new messages, lets fusion and detection finish what is queued until `deadline`
   // (steady clock), then abandons the rest and joins the threads.
@@ -151,6 +191,9 @@ class Pipeline : public SensorSink {
   // least every 200 ms while idle). A thread stuck in one stack stops advancing its beat.
   std::int64_t fusionBeatNs() const { return fusionBeat_.load(); }
   std::int64_t detectionBeatNs() const { return detectionBeat_.load(); }
+  // The network thread's (with a network; else 0: there is none).
+  std::int64_t networkBeatNs() const { return networkBeat_.load(); }
+  bool hasNetworkThread() const { return hasNetwork_; }
 
  private:
   struct EndOfStream {};
@@ -164,10 +207,18 @@ class Pipeline : public SensorSink {
     double fuseMs = 0;
     StageTimes stages;
     std::chrono::steady_clock::time_point queuedAt;
+    cv::Mat image;             // the undistorted camera image, until the network ran on it
+    std::string networkError;  // the network's run failed
   };
 
   void fusionLoop();
+  void networkLoop();
   void detectionLoop();
+  // Pushes `fused` into `queue`; in lossless mode waits for room first, showing liveness in
+  // `beat`. False when the pipeline stops meanwhile (the stack is dropped).
+  bool handOver(BoundedQueue<FusedStack>& queue, FusedStack&& fused, std::atomic<std::int64_t>& beat);
+  // The network on one stack: its layers, or the failure noted on the stack and counted.
+  void runNetwork(FusedStack& fused);
   void handle(SensorMessage& message);
   void fuseAndQueue(const fusion::Sweep& sweep, const drivers::CameraFrame& frame);
   // Runs the tracker on one stack's located detections: sets each detection's track and the
@@ -181,14 +232,17 @@ class Pipeline : public SensorSink {
 
   BoundedQueue<SensorMessage> sensorQueue_;
   BoundedQueue<FusedStack> stackQueue_;
+  const bool hasNetwork_;              // the fuser has a network: the network stage runs
+  BoundedQueue<FusedStack> networkQueue_;
   fusion::SweepAssembler assembler_;   // fusion thread only
   fusion::FramePairer pairer_;         // fusion thread only
   std::uint64_t nextStackId_ = 0;      // fusion thread only
   tracking::Tracker tracker_;          // detection thread only
 
-  std::thread fusionThread_, detectionThread_;
+  std::thread fusionThread_, networkThread_, detectionThread_;
   std::atomic<bool> abandon_{false}, detectionDone_{false};
-  std::atomic<std::int64_t> fusionBeat_{0}, detectionBeat_{0};
+  std::atomic<std::int64_t> fusionBeat_{0}, networkBeat_{0}, detectionBeat_{0};
+  LatencyRecorder networkTimes_;
 
   mutable std::mutex countersMutex_;
   PipelineCounters counters_;

@@ -27,6 +27,11 @@ class StackDetector {
   virtual std::vector<Detection> detect(const LayerStack& stack) const = 0;
   // Class names, in model order.
   virtual std::vector<std::string> classes() const = 0;
+  // The classes whose models read the network's layers (neural_*, config section neural).
+  virtual std::vector<std::string> networkClasses() const { return {}; }
+  // Detections of every class not in networkClasses(), for a stack the network failed on (it
+  // lacks the network's layers). Same boxes, scores and order as detect() gives those classes.
+  virtual std::vector<Detection> detectWithoutNetwork(const LayerStack& stack) const { return detect(stack); }
 };
 
 // The config's detection section in the library's terms (one meaning for every key).
@@ -48,6 +53,8 @@ class CascadeSet : public StackDetector {
 
   std::vector<Detection> detect(const LayerStack& stack) const override;
   std::vector<std::string> classes() const override;
+  std::vector<std::string> networkClasses() const override;
+  std::vector<Detection> detectWithoutNetwork(const LayerStack& stack) const override;
   const std::vector<std::filesystem::path>& files() const { return files_; }
   // detection.classes entries that name no loaded model (a typo, or a class not deployed): they
   // change nothing, so the constructor logs a warning naming them and the loaded classes.
@@ -55,6 +62,9 @@ class CascadeSet : public StackDetector {
 
  private:
   std::unique_ptr<boosting::MultiDetector> detector_;
+  // The models that do not read network layers (null when every model does), for
+  // detectWithoutNetwork; the same Cascade objects' copies, in the same order.
+  std::unique_ptr<boosting::MultiDetector> withoutNetwork_;
   std::vector<std::filesystem::path> files_;
   boosting::ScanParams scan_;
   boosting::GroupParams group_;

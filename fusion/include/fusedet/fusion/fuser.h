@@ -38,6 +38,14 @@ class Fuser {
   // and source are left to the caller.
   LayerStack fuse(const cv::Mat& bgr, const Sweep& sweep, FuseTimings* timings = nullptr) const;
 
+  // fuse() in two steps, for a caller that runs the network on another thread (fusedetd's
+  // pipeline): fuseSensors() makes every layer but the network's and hands out the undistorted
+  // image; addNetworkLayers() then adds the network's layers from that image (nothing without a
+  // network). fuse() is exactly these two calls.
+  LayerStack fuseSensors(const cv::Mat& bgr, const Sweep& sweep, cv::Mat* undistorted,
+                         FuseTimings* timings = nullptr) const;
+  void addNetworkLayers(LayerStack& stack, const cv::Mat& undistorted, FuseTimings* timings = nullptr) const;
+
   // The layers fuse() makes, in its order (a model needing any other cannot run on its stacks;
   // hue_distance is derived from hue per model at detection time).
   static std::vector<std::string> layerNames();

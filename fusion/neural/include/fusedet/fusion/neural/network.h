@@ -11,7 +11,10 @@
 // input size the network refuses fails at load, naming the file.
 //
 // Determinism: cv::dnn's CPU backend, float32, and OpenCV's thread count set to `threads` (a
-// process-wide OpenCV setting) before each run; the same image gives the same output bytes.
+// process-wide OpenCV setting) for each run where it differs, and set back after it; the same
+// image gives the same output bytes. A process that runs OpenCV on other threads at the same time
+// sets the count to `threads` once before they start (fusedetd's pipeline does): a run then never
+// changes it (with TBB, OpenCV's setNumThreads rebuilds the arena other threads may be working in).
 
 #include <cstdint>
 #include <filesystem>
@@ -73,6 +76,10 @@ class Network {
 
   const NetworkIdentity& identity() const { return identity_; }
   const NetworkSpec& spec() const { return spec_; }
+  // Anchor rows and class columns of run()'s output, as the probe at load found them: every run
+  // of this network has this shape (the input size is fixed).
+  std::size_t anchorRows() const { return anchorRows_; }
+  int classes() const { return classes_; }
 
   // One forward pass on an 8-bit BGR image of any size.
   NetworkOutput forward(const cv::Mat& bgr);
@@ -83,6 +90,8 @@ class Network {
   struct Impl;
   NetworkSpec spec_;
   NetworkIdentity identity_;
+  std::size_t anchorRows_ = 0;
+  int classes_ = 0;
   std::unique_ptr<Impl> impl_;
 };
 

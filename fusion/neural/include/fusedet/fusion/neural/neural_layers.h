@@ -12,6 +12,7 @@
 // else $FUSEDET_NETWORKS_DIR, else /usr/share/fusedet/networks.
 
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <opencv2/core/mat.hpp>
 #include <string>
@@ -40,14 +41,21 @@ std::vector<std::filesystem::path> defaultNetworkFiles(NetworkKind kind, const s
 // The spec the options name (files resolved: given files relative to `directory` when relative).
 NetworkSpec networkSpecFor(const NeuralLayerOptions& options);
 
+// What runs the loaded network on one image: Network::run unless given (a test wraps it to make
+// a run fail the ways a real one can: cv::dnn throwing, an output of another shape).
+using NetworkRun = std::function<Anchors(Network&, const cv::Mat&)>;
+
 class NeuralLayers {
  public:
   // Loads the network; throws std::runtime_error naming the file and the problem (network.h).
-  explicit NeuralLayers(const NeuralLayerOptions& options);
+  explicit NeuralLayers(const NeuralLayerOptions& options, NetworkRun run = {});
 
   // Runs the network on `bgr` (8-bit BGR, the stack's camera image: its size is the stack's
   // reference size or proportional to it) and adds the score layers and the network's record to
   // `stack`. One run at a time (a mutex): safe to call from several threads.
+  // A run that fails adds nothing and throws std::runtime_error naming the network and the
+  // problem: cv::dnn threw, or the output is not what the network gave at load (the number of
+  // anchor rows and classes; every score finite and in [0, 1], every box finite).
   void add(LayerStack& stack, const cv::Mat& bgr) const;
 
   const NetworkIdentity& identity() const { return network_.identity(); }
@@ -55,10 +63,13 @@ class NeuralLayers {
   // The layers add() makes, in its order.
   std::vector<std::string> layerNames() const;
   double scale() const { return scale_; }
+  // OpenCV threads of a run (NeuralLayerOptions::threads).
+  int threads() const { return network_.spec().threads; }
 
  private:
   mutable std::mutex mutex_;
   mutable Network network_;
+  NetworkRun run_;
   double scale_;
 };
 
