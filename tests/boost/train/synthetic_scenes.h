@@ -20,7 +20,11 @@ namespace fusedet::synthetic {
 inline DatasetItem scene(unsigned seed, int cars, bool withHue) {
   std::mt19937 rng(seed);
   cv::Mat img(120, 200, CV_8U);
-  cv::randu(img, 60, 140);
+  // The background's noise from a generator of the scene's own: cv::randu() draws from OpenCV's
+  // per-thread generator, whose state is whatever ran before in the process, so a test's scenes
+  // (and what its cascade detects) depended on the tests before it in the same program.
+  cv::RNG noise(seed);
+  noise.fill(img, cv::RNG::UNIFORM, 60, 140);
   cv::Mat hue(120, 200, CV_32F, cv::Scalar(40.f));
   DatasetItem item;
   item.id = "synthetic/" + std::to_string(seed);

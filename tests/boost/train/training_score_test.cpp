@@ -195,7 +195,9 @@ TEST(TrainingScore, LearningCurvePointScoresThePointsTrainingItemsOnly) {
   const TrainingConfig config = oneThreadConfig();
   std::vector<Labels> labels;
   for (const DatasetItem& it : items) labels.push_back(it.labels);
-  const Fold sub = learningPositivesFold(folds[0], positivesPerItem(labels, match), 10, 7);
+  // Seed 2: a subset whose small cascade finds cars on its own items, so the check below is not
+  // vacuous (on these scenes most 5-scene subsets train a cascade that finds none: seeds 1, 3, 7).
+  const Fold sub = learningPositivesFold(folds[0], positivesPerItem(labels, match), 10, 2);
   ASSERT_LT(sub.train.size(), folds[0].train.size());  // 5 of the 10 scenes
   ASSERT_GE(sub.train.size(), 5u);
   const Detector det = trainedLike(items, sub, config);  // the point's cascade, trained here
