@@ -55,6 +55,29 @@ TEST(CanopenProtocol, AbortAndEmcyTexts) {
   EXPECT_EQ(emcyFrame(5, *e).toString(), "085#1186210000000000");
 }
 
+// Payload bytes little-endian; a count past the payload or beyond 4 is cut, never written past it.
+TEST(CanopenProtocol, LittleEndianPayloadsStayInTheirBuffer) {
+  std::array<std::uint8_t, 8> b{};
+  writeLe(b, 1, 0x607A, 2);
+  EXPECT_EQ(b[1], 0x7A);
+  EXPECT_EQ(b[2], 0x60);
+  EXPECT_EQ(readLe(b, 1, 2), 0x607Au);
+  writeLe(b, 4, 0xDDCCBBAA, 4);
+  EXPECT_EQ(readLe(b, 4, 4), 0xDDCCBBAAu);
+  std::array<std::uint8_t, 10> guarded{};
+  guarded.fill(0xEE);
+  writeLe(std::span<std::uint8_t>(guarded).subspan(1, 8), 6, 0x44332211, 4);
+  EXPECT_EQ(guarded[7], 0x11);
+  EXPECT_EQ(guarded[8], 0x22);
+  EXPECT_EQ(guarded[9], 0xEE) << "written past the span";
+  guarded.fill(0xEE);
+  writeLe(std::span<std::uint8_t>(guarded).subspan(1, 8), 0, 0x44332211, 7);
+  EXPECT_EQ(guarded[4], 0x44);
+  EXPECT_EQ(guarded[5], 0xEE) << "more than 4 bytes of a 32-bit value";
+  writeLe(std::span<std::uint8_t>(guarded).subspan(1, 8), 9, 0x1, 1);  // past the end: nothing
+  EXPECT_EQ(guarded[9], 0xEE);
+}
+
 TEST(CanopenProtocol, StatuswordStates) {
   EXPECT_EQ(decodeStatusword(0x0000), DriveState::kNotReadyToSwitchOn);
   EXPECT_EQ(decodeStatusword(0x0250), DriveState::kSwitchOnDisabled);

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <regex>
+
 #include <opencv2/imgproc.hpp>
 #include <algorithm>
 #include <cmath>
@@ -174,7 +176,11 @@ TEST(CascadeTrainer, ClearErrorsForNoPositivesAndMissingLayers) {
     trainCascade(c, items, quiet);
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("training item synthetic/100"), std::string::npos) << e.what();
+    // Every item lacks the layer; which one a worker meets first is the parallel loop's order
+    // (synthetic/100 on 2 x86 cores, synthetic/103 on arm64 under qemu), so any of them is right.
+    EXPECT_TRUE(std::regex_search(std::string(e.what()),
+                                  std::regex("training item synthetic/1[0-9][0-9]: layer 'distance' not in stack")))
+        << e.what();
   }
   c.pool.layers = {"intensity"};
   c.stage.minHit = 1.5;

@@ -3,6 +3,7 @@
 // CANopen CiA 301 / CiA 402 facts (design.md §3): COB-IDs, NMT, SDO command bytes, abort codes,
 // EMCY, heartbeat states, statusword/controlword. Pure functions, no I/O.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -112,8 +113,12 @@ inline std::uint32_t readLe(std::span<const std::uint8_t> b, std::size_t at, int
   for (int i = bytes - 1; i >= 0; --i) v = v << 8 | b[at + static_cast<std::size_t>(i)];
   return v;
 }
+// Writes at most 4 bytes and never past the span: callers pass 1..4 bytes that fit, which GCC 12
+// for aarch64 cannot prove at -O3 (-Wstringop-overflow in the SDO client).
 inline void writeLe(std::span<std::uint8_t> b, std::size_t at, std::uint32_t v, int bytes) {
-  for (int i = 0; i < bytes; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+  const std::size_t room = at < b.size() ? b.size() - at : 0;
+  const std::size_t n = std::min(static_cast<std::size_t>(std::clamp(bytes, 0, 4)), room);
+  for (std::size_t i = 0; i < n; ++i) b[at + i] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
 }  // namespace fusedet::drivers::canopen
