@@ -7,6 +7,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <exception>
 #include <random>
 #include <stdexcept>
 
@@ -97,6 +98,9 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
     labels_.push_back(std::move(labels));
   }
   integrals_.resize(source.size());
+  // A failure is kept per item and the first in item order is thrown after the loop, so the
+  // error names the same item whatever order the workers met them in.
+  std::vector<std::exception_ptr> failed(source.size());
   auto integrate = [&](std::size_t k) {
     const auto [i, mirrored] = source[k];
     if (!shard_.owns(i)) return;
@@ -104,8 +108,8 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
       integrals_[k] = mirrored ? IntegralStack(flipItem(items[i]).stack, layers, referenceHue)
                                : IntegralStack(items[i].stack, layers, referenceHue);
     } catch (const std::exception& e) {
-      throw std::runtime_error("training item " + (mirrored ? items[i].id + "#flipped" : items[i].id) + ": " +
-                               e.what());
+      failed[k] = std::make_exception_ptr(std::runtime_error(
+          "training item " + (mirrored ? items[i].id + "#flipped" : items[i].id) + ": " + e.what()));
     }
   };
   if (threads == 1) {
@@ -119,6 +123,8 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
                         });
     });
   }
+  for (const std::exception_ptr& e : failed)
+    if (e) std::rethrow_exception(e);
 }
 
 double TrainingStacks::positiveAspect() const {
