@@ -13,3 +13,7 @@ fusedet_bench(bench_calib_heldout SOURCES calib_heldout_bench.cpp DEPS fusedet_c
 # on the same corners of opencv-doc's sample photographs (README.md has the table).
 fusedet_bench(bench_camera_intrinsics SOURCES camera_intrinsics_bench.cpp DEPS fusedet_calibration opencv_calib3d CLI11::CLI11
               SMOKE_ARGS --repeats 1)
+# Issue 33: KITTI's sweeps as recorded and de-skewed by the car's motion during the Velodyne's turn,
+# edge-measure peaks per frame and calibration trials on both (README.md has the table).
+fusedet_bench(bench_calib_deskew SOURCES calib_deskew_bench.cpp DEPS fusedet_calibration fusedet_datasets CLI11::CLI11
+              SMOKE_ARGS --every 13 --trials 1 --min-frames 3 --max-frames 3)
