@@ -72,6 +72,10 @@ int main(int argc, char** argv) {
   app.add_option("--trials", trials, "calibration trials (random subsets and starts), each on both versions")->capture_default_str();
   app.add_option("--min-frames", minFrames, "smallest subset")->capture_default_str();
   app.add_option("--max-frames", maxFrames, "largest subset")->capture_default_str();
+  std::string spin = "clockwise";
+  app.add_option("--spin", spin, "which way the beam turns, seen from above (the other way is the check that the sense matters)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clockwise", "counter-clockwise"}));
   app.add_option("--every", every, "use every n-th frame of each directory (its motion still from the sweep before it)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -116,7 +120,7 @@ int main(int argc, char** argv) {
         truth = p.sweepToCamera;
       }
       CalibFrame g = f;
-      deskewSweep(g.sweep, m, kFramePeriod);
+      deskewSweep(g.sweep, m, kFramePeriod, spin == "clockwise" ? SpinSense::kClockwise : SpinSense::kCounterClockwise);
       d.recorded.push_back(std::move(f));
       d.deskewed.push_back(std::move(g));
       d.motion.push_back(m);
@@ -124,6 +128,7 @@ int main(int argc, char** argv) {
     drives.push_back(std::move(d));
   }
 
+  std::printf("de-skewed with the beam turning %s\n", spin.c_str());
   std::printf("frame            speed  yaw_rate | edge peak, recorded: rx ry rz [deg] tx ty tz [cm] | de-skewed: the same\n");
   std::printf("                 [m/s]  [deg/s]  |\n");
   for (const DriveFrames& d : drives) {
