@@ -29,7 +29,8 @@ detection: {models: [$(ls "$models"/*.json | paste -sd, -)]}
 live: {listen: "127.0.0.1:0", viewer_queue_bytes: 1048576}
 replay: {file: $work/scene.mcap, realtime: true, speed: 2.0, at_end: loop}
 YAML
-"$fusedetd" --config "$work/live.yaml" 2> "$work/fusedetd.log" &
+: > "$work/fusedetd.log"  # exists before the wait below reads it (the background shell opens it later under load)
+"$fusedetd" --config "$work/live.yaml" 2>> "$work/fusedetd.log" &
 pid=$!
 trap 'kill $pid 2>/dev/null; wait $pid 2>/dev/null || true' EXIT
 address=
