@@ -6,6 +6,8 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <stdexcept>
 
 #include "fusedet/core/hue_distance.h"
@@ -21,37 +23,74 @@ struct Source {
   cv::Mat hueValid;                     // the hue layer's mask (empty = every pixel has a hue)
 };
 
-// Integral rows of one slot, the recurrence of integrateLayer(): rowSum += v; cur = prev + rowSum.
-template <class T, class Acc>
-void integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
-  const int w = data.cols, h = data.rows;
-  for (int y = 0; y < h; ++y) {
-    const T* row = data.ptr<T>(y);
-    const Acc* prev = slot0 + y * pitch;
-    Acc* cur = slot0 + (y + 1) * pitch;
-    Acc rowSum = 0;
-    for (int x = 0; x < w; ++x) {
-      rowSum += static_cast<Acc>(row[x]);
-      cur[x + 1] = prev[x + 1] + rowSum;
+// |v| as an unsigned integer that orders like it: the bits of a float or double without its sign
+// (every NaN above +inf), an integer's value. Kept with integer maxima, which compile without
+// branches, beside the integration's own dependency chain.
+inline std::uint32_t magnitudeKey(float v) { return std::bit_cast<std::uint32_t>(v) & 0x7fffffffu; }
+inline std::uint64_t magnitudeKey(double v) { return std::bit_cast<std::uint64_t>(v) & 0x7fffffffffffffffull; }
+inline std::uint32_t magnitudeKey(std::uint8_t v) { return v; }
+inline std::uint32_t magnitudeKey(std::uint16_t v) { return v; }
+inline double magnitude(std::uint32_t key, float) { return std::bit_cast<float>(key); }
+inline double magnitude(std::uint64_t key, double) { return std::bit_cast<double>(key); }
+template <class T>
+inline double magnitude(std::uint32_t key, T) { return key; }
+
+// Integral rows of one slot, the recurrence of integrateLayer(): per row rowSum += v; cur = prev +
+// rowSum; kRows rows at a time (their rowSum chains are independent: the additions of one row no
+// longer wait for each other's latency; each value is the same sum as row by row). rowAt(y, k)
+// gives the layer's row y (k: which of the kRows rows, for a caller that derives them). With
+// kBound, `most` keeps the largest magnitudeKey() of the values.
+template <int kRows, bool kBound, class T, class Acc, class Key, class RowAt>
+void integrateRows(int y0, int w, const RowAt& rowAt, Acc* slot0, std::ptrdiff_t pitch, Key& most) {
+  const T* in[kRows];
+  Acc* cur[kRows];
+  Acc rowSum[kRows];
+  for (int k = 0; k < kRows; ++k) {
+    in[k] = rowAt(y0 + k, k);
+    cur[k] = slot0 + (y0 + 1 + k) * pitch;
+    rowSum[k] = 0;
+  }
+  const Acc* prev = slot0 + y0 * pitch;
+  for (int x = 0; x < w; ++x) {
+    Acc above = prev[x + 1];
+    for (int k = 0; k < kRows; ++k) {
+      const T v = in[k][x];
+      rowSum[k] += static_cast<Acc>(v);
+      above = above + rowSum[k];
+      cur[k][x + 1] = above;
+      if constexpr (kBound) most = std::max(most, magnitudeKey(v));
     }
   }
 }
 
-void integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, double* slot0,
-                          std::ptrdiff_t pitch) {
-  const int w = hue.cols, h = hue.rows;
-  std::vector<float> dist(static_cast<std::size_t>(w));
-  for (int y = 0; y < h; ++y) {
-    hueDistanceRow(hue.ptr<float>(y), valid.empty() ? nullptr : valid.ptr<unsigned char>(y), dist.data(), w,
-                   reference);
-    const double* prev = slot0 + y * pitch;
-    double* cur = slot0 + (y + 1) * pitch;
-    double rowSum = 0;
-    for (int x = 0; x < w; ++x) {
-      rowSum += static_cast<double>(dist[static_cast<std::size_t>(x)]);
-      cur[x + 1] = prev[x + 1] + rowSum;
-    }
-  }
+// Every row of one slot (see integrateRows); returns the largest |value| (IntegralGrid::bounds)
+// with kBound, else 0.
+template <bool kBound, class T, class Acc, class RowAt>
+double integrateRowsOf(int w, int h, const RowAt& rowAt, Acc* slot0, std::ptrdiff_t pitch) {
+  constexpr int kRows = 4;
+  decltype(magnitudeKey(T{})) most = 0;
+  int y = 0;
+  for (; y + kRows <= h; y += kRows) integrateRows<kRows, kBound, T>(y, w, rowAt, slot0, pitch, most);
+  for (; y < h; ++y) integrateRows<1, kBound, T>(y, w, rowAt, slot0, pitch, most);
+  return magnitude(most, T{});
+}
+
+template <bool kBound, class T, class Acc>
+double integrateSlot(const cv::Mat& data, Acc* slot0, std::ptrdiff_t pitch) {
+  return integrateRowsOf<kBound, T>(
+      data.cols, data.rows, [&](int y, int) { return data.ptr<T>(y); }, slot0, pitch);
+}
+
+double integrateHueDistance(const cv::Mat& hue, const cv::Mat& valid, double reference, double* slot0,
+                            std::ptrdiff_t pitch) {
+  const int w = hue.cols;
+  std::vector<float> dist(static_cast<std::size_t>(w) * 4);
+  auto rowAt = [&](int y, int k) {
+    float* out = dist.data() + static_cast<std::size_t>(k) * static_cast<std::size_t>(w);
+    hueDistanceRow(hue.ptr<float>(y), valid.empty() ? nullptr : valid.ptr<unsigned char>(y), out, w, reference);
+    return static_cast<const float*>(out);
+  };
+  return integrateRowsOf<true, float>(w, hue.rows, rowAt, slot0, pitch);
 }
 
 // int32 tables are exact for 8-bit layers up to this many pixels (255 * pixels < 2^31).
@@ -59,13 +98,13 @@ bool fitsInt32(const cv::Mat& data) {
   return data.depth() == CV_8U && double(data.cols) * double(data.rows) * 255.0 < 2147483647.0;
 }
 
-void integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
+double integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
   if (s.hueReference) return integrateHueDistance(s.data, s.hueValid, *s.hueReference, slot0, pitch);
   switch (s.data.depth()) {
-    case CV_8U: return integrateSlot<std::uint8_t>(s.data, slot0, pitch);
-    case CV_16U: return integrateSlot<std::uint16_t>(s.data, slot0, pitch);
-    case CV_32F: return integrateSlot<float>(s.data, slot0, pitch);
-    case CV_64F: return integrateSlot<double>(s.data, slot0, pitch);
+    case CV_8U: return integrateSlot<true, std::uint8_t>(s.data, slot0, pitch);
+    case CV_16U: return integrateSlot<true, std::uint16_t>(s.data, slot0, pitch);
+    case CV_32F: return integrateSlot<true, float>(s.data, slot0, pitch);
+    case CV_64F: return integrateSlot<true, double>(s.data, slot0, pitch);
     default: throw std::invalid_argument("IntegralGrids: layer depth must be 8U, 16U, 32F or 64F");
   }
 }
@@ -150,6 +189,7 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
   }
   for (IntegralGrid& g : grids_) {
     g.pitch = g.stride * static_cast<std::ptrdiff_t>(g.slots.size());
+    g.bounds.assign(g.slots.size(), 0.0);
     const std::size_t n = static_cast<std::size_t>(g.pitch) * static_cast<std::size_t>(g.height + 1);
     if (g.exactInt) {
       g.idata = takeBuffer(tIntBuffers, n + kGridPad);
@@ -162,10 +202,13 @@ IntegralGrids::IntegralGrids(const LayerStack& stack, const std::vector<LayerReq
   auto run = [&](std::size_t i) {
     const Job& j = jobs[i];
     IntegralGrid& g = grids_[static_cast<std::size_t>(j.ref.grid)];
-    if (g.exactInt)
-      integrateSlot<std::uint8_t>(j.source.data, g.idata.data() + j.ref.slot * g.stride, g.pitch);
-    else
-      integrateSource(j.source, g.data.data() + j.ref.slot * g.stride, g.pitch);
+    double& bound = g.bounds[static_cast<std::size_t>(j.ref.slot)];
+    if (g.exactInt) {
+      integrateSlot<false, std::uint8_t>(j.source.data, g.idata.data() + j.ref.slot * g.stride, g.pitch);
+      bound = 255;  // 8-bit values
+    } else {
+      bound = integrateSource(j.source, g.data.data() + j.ref.slot * g.stride, g.pitch);
+    }
   };
   if (threads == 1 || jobs.size() < 2) {
     for (std::size_t i = 0; i < jobs.size(); ++i) run(i);

@@ -13,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include "fusedet/boost/float_cut.h"
 #include "fusedet/boost/parallel_for.h"
@@ -47,54 +48,72 @@ struct GridStump {
   SharedEdge shared = SharedEdge::kNone;
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
-  // The vector paths' quick form: value' =
-  // black * invBlackArea - white * invWhiteArea differs from the exact value (divisions) by less
-  // than kQuickMargin(value'), and the exact value rounded to float is below `threshold` iff the
-  // exact value is below `cut` (float_cut.h). So where |value' - cut| exceeds the margin, value' <
-  // cut is the stump's decision; the rare windows closer than that are computed exactly.
-  double invBlackArea = 1, invWhiteArea = 1, cut = 0;
+  // The vector paths' quick form: value' = black * invBlackArea - white * invWhiteArea differs
+  // from the exact value (divisions) by less than the stump's margin m (quickBounds()), and the
+  // exact value rounded to float is below `threshold` iff the exact value is below `cut`
+  // (float_cut.h). So value' < quickBelow = cut - m decides "below", value' > quickAbove = cut + m
+  // decides "not below"; the rare windows between (and NaN values) are computed exactly.
+  double invBlackArea = 1, invWhiteArea = 1, quickBelow = 0, quickAbove = 0;
   float threshold = 0;
   double left = 0, right = 0;
 };
 
-// Bound on |value' - value| (see GridStump) for black/blackArea = a, white/whiteArea = b:
-// a * (1/area) in double is within 2u|a| of a (u = 2^-53: the rounded reciprocal, the product),
-// the exact path's quotient within u|a|, and each difference within u of its result, so
-// |value' - value| <= 6u(|a'| + |b'|) (a', b' the products; second-order terms included). The
-// margin is 16u(|a'| + |b'|) plus 2^-1000 for results in the subnormal range. Infinite or NaN
-// values make the test fail, so they take the exact path.
-constexpr double kQuickMarginRelative = 0x1p-49;
-constexpr double kQuickMarginAbsolute = 0x1p-1000;
+// The margin m of one stump (see GridStump) whose layer's values lie within +-bound (its slot's
+// IntegralGrid::bounds: finite values; a window whose rectangles hold a NaN or an infinity has a NaN
+// or infinite black or white and is decided the same way on both paths or left to the exact one).
+// For black/blackArea = a, white/whiteArea = b: a * (1/area) in double is within 2u|a| of a (u =
+// 2^-53: the rounded reciprocal, the product), the exact path's quotient within u|a|, and each
+// difference within u of its result, so |value' - value| <= 6u(|a'| + |b'|) (a', b' the products;
+// second-order terms included). A rectangle sum from a double table is within 4(w + h + 3)u * bound
+// * w * h of the exact sum (the tables' recurrence over a w x h grid, then three operations), at
+// most `bound` while 4(w + h + 16)u * w * h <= 1 (every camera-size grid): then |a'| <= bound *
+// (black rectangles' area + 4 per rectangle) / blackArea, likewise |b'| (the white rectangle, plus
+// the black ones where white is the rest), and m = 16u(|a'| + |b'|) bounds, plus 2^-1000 for
+// results in the subnormal range, with room to spare. Otherwise (quick decisions off, an infinite
+// bound, a grid too large) m = +inf: every window takes the exact path. Since d < fl(x) <=> d < x
+// for doubles d and any real x, cut -+ m rounded to double keeps the guarantee.
+std::pair<double, double> quickBounds(const IntegralGrid& gr, int slot, const FeatureLayout& lay, double cut, bool quick) {
+  const double u = 0x1p-53, pixels = double(gr.width) * double(gr.height);
+  const double bound = gr.bounds[static_cast<std::size_t>(slot)];
+  double m = std::numeric_limits<double>::infinity();
+  if (quick && std::isfinite(bound) && 4.0 * (gr.width + gr.height + 16) * u * pixels <= 1.0) {
+    auto area = [](const PixelRect& r) { return double(r.x1 - r.x0) * double(r.y1 - r.y0); };
+    double black = 0;
+    for (int k = 0; k < lay.blackCount; ++k) black += area(lay.rects[static_cast<std::size_t>(k)]) + 4;
+    const double white = area(lay.rects[static_cast<std::size_t>(lay.blackCount)]) + 4 + (lay.whiteIsRest ? black : 0);
+    m = 16 * u * bound * (black / lay.blackArea + white / lay.whiteArea) * (1 + 0x1p-20) + 0x1p-1000;
+  }
+  return {cut - m, cut + m};
+}
 
 std::atomic<bool> gQuickDecisions{true};
 
-constexpr int kSpanStride = 3;
+constexpr int kSpanStride = -1;  // GridScale::colStride of narrow irregular rows
 
 struct GridStage {
   std::uint32_t begin = 0, end = 0;
   double threshold = 0;
+  std::uint32_t grids = 0;  // bit g set: a stump reads grid g
 };
 
 struct GridScale {
   ScaleWindows win;
   std::vector<std::vector<std::int32_t>> colOfs, rowOfs;  // per grid, per position
-  // Per grid: 1 or 2 when neighbouring windows' origins are that many values apart along the whole
-  // row (plain or every-other vector loads replace lane-by-lane loads in stage 0); kSpanStride when
-  // any eight neighbours' origins lie within 16 values of the first one's (two loads and a lane
-  // permutation with eight lanes; the four-lane path loads lane by lane), else 0.
+  // Per grid: d > 0 when neighbouring windows' origins are d values apart along the whole row
+  // (stage 0 loads their corners from the first one's, each path as its Lanes::corners() can:
+  // whole vectors, every other value, a few loads and shuffles); kSpanStride when any eight
+  // neighbours' origins lie within 16 values of the first one's and any four within 8 (two loads
+  // and a lane permutation), else 0 (lane by lane).
   std::vector<int> colStride;
   std::vector<GridStump> stumps;
   std::vector<GridStage> stages;
-  // kQuickMarginRelative, or +inf when quick decisions are off (setQuickStumpDecisions): then no
-  // lane is ever sure and every stump takes the exact fallback.
-  double quickMarginRelative = kQuickMarginRelative;
 };
 
 // slots[l]: where layer l's sums live.
 GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector<SlotRef>& slots,
                     ScaleWindows win) {
   GridScale sp;
-  if (!gQuickDecisions.load(std::memory_order_relaxed)) sp.quickMarginRelative = std::numeric_limits<double>::infinity();
+  const bool quick = gQuickDecisions.load(std::memory_order_relaxed);  // off: every stump exact
   const int W = in.refWidth(), H = in.refHeight();
   const std::size_t ng = in.grids().size();
   sp.colOfs.resize(ng);
@@ -111,14 +130,15 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
     const auto& co = sp.colOfs[g];
     sp.colStride.push_back(0);
-    for (int d : {1, 2}) {
+    if (co.size() > 1 && co[1] > co[0]) {
       bool regular = true;
-      for (std::size_t i = 1; i < co.size() && regular; ++i) regular = co[i] - co[i - 1] == d;
-      if (regular && co.size() > 1) sp.colStride.back() = d;
+      for (std::size_t i = 1; i < co.size() && regular; ++i) regular = co[i] - co[i - 1] == co[1] - co[0];
+      if (regular) sp.colStride.back() = co[1] - co[0];
     }
     if (sp.colStride.back() == 0) {  // offsets grow with the column: a window's span is its eighth's
       bool narrow = true;
-      for (std::size_t i = 0; i < co.size() && narrow; ++i) narrow = co[std::min(i + 7, co.size() - 1)] - co[i] <= 15;
+      for (std::size_t i = 0; i < co.size() && narrow; ++i)
+        narrow = co[std::min(i + 7, co.size() - 1)] - co[i] <= 15 && co[std::min(i + 3, co.size() - 1)] - co[i] <= 7;
       if (narrow) sp.colStride.back() = kSpanStride;
     }
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
@@ -157,12 +177,13 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       z.invBlackArea = 1.0 / lay.blackArea;
       z.invWhiteArea = 1.0 / lay.whiteArea;
       z.threshold = static_cast<float>(t.threshold);
-      z.cut = floatCut(z.threshold);
+      std::tie(z.quickBelow, z.quickAbove) = quickBounds(gr, ref.slot, lay, floatCut(z.threshold), quick);
       z.left = t.left;
       z.right = t.right;
       sp.stumps.push_back(z);
     }
     gs.end = static_cast<std::uint32_t>(sp.stumps.size());
+    for (std::uint32_t k = gs.begin; k < gs.end; ++k) gs.grids |= 1u << sp.stumps[k].grid;
     sp.stages.push_back(gs);
   }
   sp.win = std::move(win);
@@ -244,6 +265,17 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
 constexpr std::size_t kMaxVectorGrids = 8;
 
+// How a vector path loads the corners of one step's windows in one grid (GridScale::colStride):
+// lane by lane, or from the first window's origin for origins 1, 2, 3 or more values apart, or in
+// span mode. Each path's Lanes::corners<Load>() does what its instruction set can; the stage loops
+// pick the mode once per stump, so that no corner load branches on it.
+enum class Load : std::uint8_t { kLanes, kOne, kTwo, kThree, kWide, kSpan };
+constexpr Load loadOf(int stride) {
+  if (stride == kSpanStride) return Load::kSpan;
+  if (stride <= 0) return Load::kLanes;
+  return stride == 1 ? Load::kOne : stride == 2 ? Load::kTwo : stride == 3 ? Load::kThree : Load::kWide;
+}
+
 // The vector stage loops (vector_stages.inc) are written once against a `Lanes` type - the vector
 // width and its operations - and compiled once per instruction set, each copy under its own target
 // so that the AVX2 copy holds no AVX-512 instruction. Every lane does the scalar path's operations
@@ -300,35 +332,67 @@ struct Lanes {
     const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kCompressPairs[keep].data()));
     return _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), idx));
   }
-  // The windows' origins for corners(): in memory, for scalar loads.
+  // The windows' origins for corners(): in memory, for scalar loads, and in span mode (all four
+  // within 8 values of b, stride kSpanStride) the permutation that picks them from two loads: per
+  // lane the 32-bit halves of its value in a load of four (spanPairs) and whether that is the
+  // second load (spanHigh, all bits set).
   struct Index {
     alignas(16) std::int32_t k[4];
+    __m256i spanPairs;
+    __m256d spanHigh;
   };
-  static Index index(Ints o) {
+  static Index index(Ints o, int stride) {
     Index i;
     _mm_store_si128(reinterpret_cast<__m128i*>(i.k), o);
+    if (stride == kSpanStride) {
+      const __m256i k64 = _mm256_cvtepi32_epi64(o);
+      const __m256i low = _mm256_and_si256(k64, _mm256_set1_epi64x(3));
+      // lane value 2 * (k & 3) in the low half, + 1 in the high half of each 64-bit lane
+      i.spanPairs = _mm256_or_si256(_mm256_slli_epi64(low, 1), _mm256_slli_epi64(_mm256_add_epi64(_mm256_slli_epi64(low, 1), _mm256_set1_epi64x(1)), 32));
+      i.spanHigh = _mm256_castsi256_pd(_mm256_cmpgt_epi64(k64, _mm256_set1_epi64x(3)));
+    }
     return i;
   }
-  // Corner values of the windows, loaded one by one (origins b + o.k[i]) or, for neighbours whose
-  // origins are `stride` (1 or 2) apart, loaded from the first one's origin b. The same values
-  // either way. Scalar loads beat AVX2's gather instructions (measured: bench/README.md).
+  // Corner values of the windows: lane by lane (origins b + o.k[i], stride 0), or for neighbours
+  // whose origins are `stride` values apart (stage 0) from the first one's origin b with a few
+  // loads and shuffles, or in span mode picked from two loads. The same values every way. Scalar
+  // loads beat AVX2's gather instructions (measured: bench/README.md).
+  template <Load kMode>
   [[gnu::always_inline]] static Doubles corners(const double* b, const Index& o, int stride) {
-    if (stride == 1) return _mm256_loadu_pd(b);
-    if (stride == 2) {
+    if constexpr (kMode == Load::kOne) return _mm256_loadu_pd(b);
+    if constexpr (kMode == Load::kTwo) {
       const __m256d lo = _mm256_loadu_pd(b), hi = _mm256_loadu_pd(b + 4);  // p0..p3, p4..p7
       return _mm256_permute4x64_pd(_mm256_unpacklo_pd(lo, hi), 0xD8);        // p0 p4 p2 p6 -> p0 p2 p4 p6
     }
-    const __m128d lo = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
-    const __m128d hi = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
-    return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
+    if constexpr (kMode == Load::kThree)  // p0 p6 p3 p9 -> p0 p3 p6 p9
+      return _mm256_permute4x64_pd(_mm256_shuffle_pd(_mm256_loadu_pd(b), _mm256_loadu_pd(b + 6), 0xC), 0xD8);
+    if constexpr (kMode == Load::kWide) {  // [p0 . p2d .] and [pd . p3d .]
+      const __m256d a = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b)), _mm_loadu_pd(b + 2 * stride), 1);
+      const __m256d c = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(b + stride)), _mm_loadu_pd(b + 3 * stride), 1);
+      return _mm256_unpacklo_pd(a, c);  // p0 pd p2d p3d
+    }
+    if constexpr (kMode == Load::kSpan) {
+      const __m256 lo = _mm256_castpd_ps(_mm256_loadu_pd(b)), hi = _mm256_castpd_ps(_mm256_loadu_pd(b + 4));
+      return _mm256_blendv_pd(_mm256_castps_pd(_mm256_permutevar8x32_ps(lo, o.spanPairs)),
+                              _mm256_castps_pd(_mm256_permutevar8x32_ps(hi, o.spanPairs)), o.spanHigh);
+    }
+    if constexpr (kMode == Load::kLanes) {
+      const __m128d lo = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
+      const __m128d hi = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
+      return _mm256_insertf128_pd(_mm256_castpd128_pd256(lo), hi, 1);
+    }
   }
+  template <Load kMode>
   [[gnu::always_inline]] static Ints corners(const std::int32_t* b, const Index& o, int stride) {
-    if (stride == 1) return loadInts(b);
-    if (stride == 2) {
+    if constexpr (kMode == Load::kOne) return loadInts(b);
+    if constexpr (kMode == Load::kTwo) {
       const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b));
       return _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(v, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
     }
-    return _mm_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]]);
+    if constexpr (kMode == Load::kThree || kMode == Load::kWide)
+      return _mm_setr_epi32(b[0], b[stride], b[2 * stride], b[3 * stride]);
+    if constexpr (kMode == Load::kSpan || kMode == Load::kLanes)
+      return _mm_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]]);
   }
   static Doubles toDouble(Doubles v) { return v; }
   static Doubles toDouble(Ints v) { return _mm256_cvtepi32_pd(v); }
@@ -339,11 +403,11 @@ struct Lanes {
   static Doubles div(Doubles a, Doubles b) { return _mm256_div_pd(a, b); }
   static Doubles mul(Doubles a, Doubles b) { return _mm256_mul_pd(a, b); }
   static Doubles roundToFloat(Doubles v) { return _mm256_cvtps_pd(_mm256_cvtpd_ps(v)); }
-  static Doubles abs(Doubles v) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), v); }
   // Per-lane truth values: all bits of a lane set where true.
   using Mask = __m256d;
   static Mask less(Doubles a, Doubles b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
   static Mask greater(Doubles a, Doubles b) { return _mm256_cmp_pd(a, b, _CMP_GT_OQ); }
+  static Mask either(Mask a, Mask b) { return _mm256_or_pd(a, b); }
   static bool all(Mask m) { return _mm256_movemask_pd(m) == 0xF; }
   static Mask select(Mask pick, Mask a, Mask b) { return _mm256_blendv_pd(b, a, pick); }  // pick ? a : b
   // lt ? left : right, per lane.
@@ -384,7 +448,7 @@ struct Lanes {
     alignas(32) std::int32_t k[8];
     Ints v;  // the same, for the span mode's permutation
   };
-  static Index index(Ints o) {
+  static Index index(Ints o, int /*stride*/) {
     Index i;
     _mm256_store_si256(reinterpret_cast<__m256i*>(i.k), o);
     i.v = o;
@@ -392,32 +456,37 @@ struct Lanes {
   }
   // As avx2::Lanes::corners (eight scalar loads beat AVX-512's gather instructions too, measured:
   // bench/README.md); kSpanStride: the eight values lie within 16 of b (o = offsets from b),
-  // picked from two loads by a permutation.
-  [[gnu::always_inline]] static Doubles corners(const double* b, const Index& o, int stride) {
-    if (stride == 1) return _mm512_loadu_pd(b);
-    if (stride == 2)
+  // picked from two loads by a permutation; strides above 2 lane by lane (o relative to b).
+  template <Load kMode>
+  [[gnu::always_inline]] static Doubles corners(const double* b, const Index& o, int /*stride*/) {
+    if constexpr (kMode == Load::kOne) return _mm512_loadu_pd(b);
+    if constexpr (kMode == Load::kTwo)
       return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_setr_epi64(0, 2, 4, 6, 8, 10, 12, 14),
                                     _mm512_loadu_pd(b + 8));
-    if (stride == kSpanStride)
+    if constexpr (kMode == Load::kSpan)
       return _mm512_permutex2var_pd(_mm512_loadu_pd(b), _mm512_cvtepi32_epi64(o.v), _mm512_loadu_pd(b + 8));
-    const __m128d a = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
-    const __m128d c = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
-    const __m128d d = _mm_loadh_pd(_mm_load_sd(b + o.k[4]), b + o.k[5]);
-    const __m128d e = _mm_loadh_pd(_mm_load_sd(b + o.k[6]), b + o.k[7]);
-    const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(a), c, 1);
-    const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(d), e, 1);
-    return _mm512_insertf64x4(_mm512_castpd256_pd512(lo), hi, 1);
+    if constexpr (kMode == Load::kLanes || kMode == Load::kThree || kMode == Load::kWide) {
+      const __m128d a = _mm_loadh_pd(_mm_load_sd(b + o.k[0]), b + o.k[1]);
+      const __m128d c = _mm_loadh_pd(_mm_load_sd(b + o.k[2]), b + o.k[3]);
+      const __m128d d = _mm_loadh_pd(_mm_load_sd(b + o.k[4]), b + o.k[5]);
+      const __m128d e = _mm_loadh_pd(_mm_load_sd(b + o.k[6]), b + o.k[7]);
+      const __m256d lo = _mm256_insertf128_pd(_mm256_castpd128_pd256(a), c, 1);
+      const __m256d hi = _mm256_insertf128_pd(_mm256_castpd128_pd256(d), e, 1);
+      return _mm512_insertf64x4(_mm512_castpd256_pd512(lo), hi, 1);
+    }
   }
-  [[gnu::always_inline]] static Ints corners(const std::int32_t* b, const Index& o, int stride) {
-    if (stride == 1) return loadInts(b);
-    if (stride == 2) {
+  template <Load kMode>
+  [[gnu::always_inline]] static Ints corners(const std::int32_t* b, const Index& o, int /*stride*/) {
+    if constexpr (kMode == Load::kOne) return loadInts(b);
+    if constexpr (kMode == Load::kTwo) {
       const __m512i v = _mm512_loadu_si512(b);
       return _mm512_castsi512_si256(
           _mm512_permutexvar_epi32(_mm512_setr_epi32(0, 2, 4, 6, 8, 10, 12, 14, 1, 3, 5, 7, 9, 11, 13, 15), v));
     }
-    if (stride == kSpanStride)
+    if constexpr (kMode == Load::kSpan)
       return _mm512_castsi512_si256(_mm512_permutexvar_epi32(_mm512_castsi256_si512(o.v), _mm512_loadu_si512(b)));
-    return _mm256_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]], b[o.k[4]], b[o.k[5]], b[o.k[6]], b[o.k[7]]);
+    if constexpr (kMode == Load::kLanes || kMode == Load::kThree || kMode == Load::kWide)
+      return _mm256_setr_epi32(b[o.k[0]], b[o.k[1]], b[o.k[2]], b[o.k[3]], b[o.k[4]], b[o.k[5]], b[o.k[6]], b[o.k[7]]);
   }
   static Doubles toDouble(Doubles v) { return v; }
   static Doubles toDouble(Ints v) { return _mm512_cvtepi32_pd(v); }
@@ -428,10 +497,10 @@ struct Lanes {
   static Doubles div(Doubles a, Doubles b) { return _mm512_div_pd(a, b); }
   static Doubles mul(Doubles a, Doubles b) { return _mm512_mul_pd(a, b); }
   static Doubles roundToFloat(Doubles v) { return _mm512_cvtps_pd(_mm512_cvtpd_ps(v)); }
-  static Doubles abs(Doubles v) { return _mm512_abs_pd(v); }
   using Mask = __mmask8;
   static Mask less(Doubles a, Doubles b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
   static Mask greater(Doubles a, Doubles b) { return _mm512_cmp_pd_mask(a, b, _CMP_GT_OQ); }
+  static Mask either(Mask a, Mask b) { return static_cast<Mask>(a | b); }
   static bool all(Mask m) { return m == 0xFF; }
   static Mask select(Mask pick, Mask a, Mask b) { return static_cast<Mask>((pick & a) | (~pick & b)); }
   static Doubles choose(Mask lt, double left, double right) { return _mm512_mask_blend_pd(lt, splat(right), splat(left)); }

@@ -9,13 +9,18 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "fusedet/boost/model_io.h"
+#include "fusedet/boost/integral_grids.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/boost/vector_path.h"
+#include "fusedet/core/hue_distance.h"
 #include "fusedet/fusion/datasets/kitti.h"
 
 using namespace fusedet;
@@ -131,6 +136,68 @@ TEST(MultiDetector, ScalarFormEqualsVectorForms) {
     setQuickStumpDecisions(true);
     setVectorLanesLimit(8);
   }
+}
+
+// Layers whose values are NaN, infinite or huge in places: the vector forms' quick decisions (bounded
+// by each layer's largest magnitude, IntegralGrids::bounds) and their exact fallback still decide
+// as the scalar form, window for window.
+TEST(MultiDetector, ScalarFormEqualsVectorFormsOnNonFiniteAndHugeValues) {
+  const MultiDetector all(bundledModels());
+  ScanParams p;
+  p.threads = 1;
+  LayerStack s = kittiStacks().front();  // its layers' pixels are shared: the two changed are copies
+  cv::Mat& distance = s.find(layer::kDistance)->data;
+  cv::Mat& remission = s.find(layer::kRemission)->data;
+  distance = distance.clone();
+  remission = remission.clone();
+  ASSERT_EQ(distance.type(), CV_32FC1);
+  const int w = distance.cols, h = distance.rows;
+  distance(cv::Rect(w / 8, h / 4, w / 10, h / 3)).setTo(std::numeric_limits<float>::quiet_NaN());
+  distance(cv::Rect(w / 2, h / 2, w / 12, h / 4)).setTo(std::numeric_limits<float>::infinity());
+  cv::Mat huge = remission(cv::Rect(remission.cols / 3, 0, remission.cols / 6, remission.rows / 2));
+  huge.convertTo(huge, -1, 1e30);
+  std::vector<ScanStats> a;
+  setVectorScanEnabled(false);
+  const auto scalar = all.scan(s, p, &a);
+  setVectorScanEnabled(true);
+  for (int lanes : {8, 4}) {
+    setVectorLanesLimit(lanes);
+    std::vector<ScanStats> b;
+    const auto vec = all.scan(s, p, &b);
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      expectSameHits(vec[i], scalar[i], all.cascade(i).className + " " + std::to_string(lanes) + " lanes");
+      EXPECT_EQ(a[i].stumps, b[i].stumps);
+    }
+  }
+  setVectorLanesLimit(8);
+}
+
+// IntegralGrids::bounds, which the quick decisions rest on: each layer's largest |value| (NaN when
+// a value is NaN), 255 for 8-bit layers in int32 tables, the derived hue_distance's own.
+TEST(IntegralGrids, BoundsAreEachLayersLargestMagnitude) {
+  LayerStack s(64, 48);
+  cv::Mat f(48, 64, CV_32FC1), u16(48, 64, CV_16UC1), hue(48, 64, CV_32FC1), u8(48, 64, CV_8UC1, cv::Scalar(7));
+  cv::randu(f, -50.f, 20.f);
+  f.at<float>(30, 9) = -77.5f;
+  cv::randu(u16, 0, 4000);
+  u16.at<std::uint16_t>(3, 3) = 60000;
+  cv::randu(hue, 0.f, 359.f);
+  s.set(Layer{"distance", f, {}});
+  s.set(Layer{"remission", u16, {}});
+  s.set(Layer{"hue", hue, {}});
+  s.set(Layer{"red", u8, {}});
+  const IntegralGrids grids(s, {{"distance", {}}, {"remission", {}}, {"hue_distance", 215.0}, {"red", {}}}, 1);
+  auto bound = [&](const LayerRequest& r) {
+    const SlotRef ref = grids.find(r);
+    return grids.grids()[static_cast<std::size_t>(ref.grid)].bounds[static_cast<std::size_t>(ref.slot)];
+  };
+  EXPECT_EQ(bound({"distance", {}}), 77.5);
+  EXPECT_EQ(bound({"remission", {}}), 60000.0);
+  EXPECT_EQ(bound({"hue_distance", 215.0}), cv::norm(hueDistanceLayer(hue, 215.0), cv::NORM_INF));
+  EXPECT_EQ(bound({"red", {}}), 255.0);
+  f.at<float>(40, 60) = std::numeric_limits<float>::quiet_NaN();
+  const IntegralGrids withNan(s, {{"distance", {}}}, 1);
+  EXPECT_TRUE(std::isnan(withNan.grids().front().bounds.front()));
 }
 
 // The optimised scanner (one pass, widest vector path, quick stump decisions, branch-free survivor

@@ -38,6 +38,9 @@ struct IntegralGrid {
   std::ptrdiff_t stride = 0;       // width + 1: one layer's integral row
   std::ptrdiff_t pitch = 0;        // slots * stride: one integral row of every slot
   std::vector<LayerRequest> slots;
+  // Per slot: the largest |value| of its layer (NaN if a value is NaN), which bounds its rectangle
+  // sums for the scanner's quick decisions.
+  std::vector<double> bounds;
   std::vector<double> data;        // (height + 1) * pitch values, then padding for vector reads
   std::vector<std::int32_t> idata;  // the same layout when exactInt
   const void* base() const { return exactInt ? static_cast<const void*>(idata.data()) : data.data(); }
