@@ -7,6 +7,11 @@
 #include <cstdlib>
 #include <string_view>
 
+#if defined(__aarch64__) && defined(__linux__)
+#include <asm/hwcap.h>
+#include <sys/auxv.h>
+#endif
+
 #include "fusedet/boost/detector.h"
 #include "fusedet/boost/opencv_cascade.h"
 
@@ -18,11 +23,21 @@ constexpr const char* kEnv = "FUSEDET_SIMD";
 
 // Windows per step of a path named as FUSEDET_SIMD takes it, 0 for an unknown name.
 int lanesNamed(std::string_view name) {
+#if defined(__aarch64__)
+  if (name == "neon") return 4;
+#else
   if (name == "avx512") return 8;
   if (name == "avx2") return 4;
+#endif
   if (name == "scalar") return 1;
   return 0;
 }
+
+#if defined(__aarch64__)
+constexpr const char* kPathNames = "neon, scalar";
+#else
+constexpr const char* kPathNames = "avx512, avx2, scalar";
+#endif
 
 // FUSEDET_SIMD's limit, read once: 8 (no limit) when unset or unknown.
 int environmentLimit() {
@@ -31,7 +46,7 @@ int environmentLimit() {
     if (!v) return 8;
     const int lanes = lanesNamed(v);
     if (lanes == 0) {
-      std::fprintf(stderr, "fusedet: %s=%s is not a vector path (avx512, avx2, scalar); ignored\n", kEnv, v);
+      std::fprintf(stderr, "fusedet: %s=%s is not a vector path (%s); ignored\n", kEnv, v, kPathNames);
       return 8;
     }
     return lanes;
@@ -53,6 +68,8 @@ int cpuVectorLanes() {
                            : __builtin_cpu_supports("avx2")                                         ? 4
                                                                                                     : 1;
   return lanes;
+#elif defined(__aarch64__) && defined(__GNUC__)
+  return 4;  // NEON (Advanced SIMD) is part of every AArch64 CPU
 #else
   return 1;
 #endif
@@ -67,8 +84,12 @@ int dispatchedVectorLanes() {
 }
 
 std::string vectorPathName(int lanes) {
+#if defined(__aarch64__)
+  if (lanes >= 4) return "neon";
+#else
   if (lanes >= 8) return "avx512";
   if (lanes >= 4) return "avx2";
+#endif
   return "scalar";
 }
 
@@ -87,6 +108,8 @@ std::string cpuVectorExtensions() {
   add("avx512f", __builtin_cpu_supports("avx512f"));
   add("avx512vl", __builtin_cpu_supports("avx512vl"));
   add("avx512bw", __builtin_cpu_supports("avx512bw"));
+#elif defined(__aarch64__) && defined(__linux__)
+  if (getauxval(AT_HWCAP) & HWCAP_ASIMD) out = "asimd";  // NEON, as the kernel names it
 #endif
   return out.empty() ? "none" : out;
 }

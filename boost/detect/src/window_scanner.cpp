@@ -13,7 +13,6 @@
 #include <limits>
 #include <stdexcept>
 #include <tuple>
-#include <utility>
 
 #include "fusedet/boost/float_cut.h"
 #include "fusedet/boost/parallel_for.h"
@@ -25,6 +24,14 @@
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #include <immintrin.h>
 #define FUSEDET_HAVE_AVX2_GRID_PATH 1
+#endif
+// arm64: NEON is part of every AArch64 CPU, its intrinsics need no target pragma.
+#if defined(__aarch64__) && defined(__GNUC__)
+#include <arm_neon.h>
+#define FUSEDET_HAVE_NEON_GRID_PATH 1
+#endif
+#if defined(FUSEDET_HAVE_AVX2_GRID_PATH) || defined(FUSEDET_HAVE_NEON_GRID_PATH)
+#define FUSEDET_HAVE_VECTOR_GRID_PATH 1
 #endif
 
 namespace fusedet::boosting {
@@ -49,7 +56,7 @@ struct GridStump {
   std::array<std::array<std::int32_t, 4>, 3> ofs{};
   double blackArea = 1, whiteArea = 1;
   // The vector paths' quick form: value' = black * invBlackArea - white * invWhiteArea differs
-  // from the exact value (divisions) by less than the stump's margin m (quickBounds()), and the
+  // from the exact value (divisions) by less than the stump's margin m (setQuickBounds()), and the
   // exact value rounded to float is below `threshold` iff the exact value is below `cut`
   // (float_cut.h). So value' < quickBelow = cut - m decides "below", value' > quickAbove = cut + m
   // decides "not below"; the rare windows between (and NaN values) are computed exactly.
@@ -72,7 +79,8 @@ struct GridStump {
 // results in the subnormal range, with room to spare. Otherwise (quick decisions off, an infinite
 // bound, a grid too large) m = +inf: every window takes the exact path. Since d < fl(x) <=> d < x
 // for doubles d and any real x, cut -+ m rounded to double keeps the guarantee.
-std::pair<double, double> quickBounds(const IntegralGrid& gr, int slot, const FeatureLayout& lay, double cut, bool quick) {
+// Sets z.quickBelow and z.quickAbove.
+void setQuickBounds(GridStump& z, const IntegralGrid& gr, int slot, const FeatureLayout& lay, double cut, bool quick) {
   const double u = 0x1p-53, pixels = double(gr.width) * double(gr.height);
   const double bound = gr.bounds[static_cast<std::size_t>(slot)];
   double m = std::numeric_limits<double>::infinity();
@@ -83,7 +91,8 @@ std::pair<double, double> quickBounds(const IntegralGrid& gr, int slot, const Fe
     const double white = area(lay.rects[static_cast<std::size_t>(lay.blackCount)]) + 4 + (lay.whiteIsRest ? black : 0);
     m = 16 * u * bound * (black / lay.blackArea + white / lay.whiteArea) * (1 + 0x1p-20) + 0x1p-1000;
   }
-  return {cut - m, cut + m};
+  z.quickBelow = cut - m;
+  z.quickAbove = cut + m;
 }
 
 std::atomic<bool> gQuickDecisions{true};
@@ -177,7 +186,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       z.invBlackArea = 1.0 / lay.blackArea;
       z.invWhiteArea = 1.0 / lay.whiteArea;
       z.threshold = static_cast<float>(t.threshold);
-      std::tie(z.quickBelow, z.quickAbove) = quickBounds(gr, ref.slot, lay, floatCut(z.threshold), quick);
+      setQuickBounds(z, gr, ref.slot, lay, floatCut(z.threshold), quick);
       z.left = t.left;
       z.right = t.right;
       sp.stumps.push_back(z);
@@ -262,7 +271,7 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
   return kept;
 }
 
-#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+#ifdef FUSEDET_HAVE_VECTOR_GRID_PATH
 constexpr std::size_t kMaxVectorGrids = 8;
 
 // How a vector path loads the corners of one step's windows in one grid (GridScale::colStride):
@@ -281,9 +290,9 @@ constexpr Load loadOf(int stride) {
 // so that the AVX2 copy holds no AVX-512 instruction. Every lane does the scalar path's operations
 // in the same order (add/sub/div, no FMA), so the lanes equal stageScalar() bit for bit.
 
-// Tables for compressing four lanes (AVX2 has no compress instruction): for each mask of lanes to
-// keep, the source lane of each destination lane, as bytes of 32-bit lanes (kCompressBytes) and as
-// 32-bit halves of 64-bit lanes (kCompressPairs).
+// Tables for compressing four lanes (AVX2 and NEON have no compress instruction): for each mask of
+// lanes to keep, the source lane of each destination lane, as bytes of 32-bit lanes
+// (kCompressBytes) and, for AVX2, as 32-bit halves of 64-bit lanes (kCompressPairs).
 constexpr std::array<int, 4> compressOrder(int keep) {
   std::array<int, 4> src{0, 0, 0, 0};
   int n = 0;
@@ -300,6 +309,7 @@ constexpr std::array<std::array<std::int8_t, 16>, 16> kCompressBytes = [] {
             static_cast<std::int8_t>(4 * compressOrder(m)[static_cast<std::size_t>(d)] + b);
   return t;
 }();
+#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
 constexpr std::array<std::array<std::int32_t, 8>, 16> kCompressPairs = [] {
   std::array<std::array<std::int32_t, 8>, 16> t{};
   for (int m = 0; m < 16; ++m)
@@ -513,6 +523,16 @@ struct Lanes {
 }  // namespace avx512
 #pragma GCC diagnostic pop
 #pragma GCC pop_options
+namespace four = avx2;  // the four-lane path
+#endif
+
+#ifdef FUSEDET_HAVE_NEON_GRID_PATH
+namespace neon {
+#include "neon_lanes.inc"
+#include "vector_stages.inc"
+}  // namespace neon
+namespace four = neon;
+#endif
 
 // The dispatched path (vector_path.h): 8, 4 or 1 lanes; scalar for more grids than the vector
 // loops hold.
@@ -555,7 +575,7 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
               std::size_t& stumps) {
   const std::size_t windows = (x1 - x0) * (y1 - y0);
   if (l.cap < windows + WindowList::kPad || l.grids != ng) l.reserve(windows, ng);
-#ifdef FUSEDET_HAVE_AVX2_GRID_PATH
+#ifdef FUSEDET_HAVE_VECTOR_GRID_PATH
   const int lanes = vectorLanes(ng);
 #else
   const int lanes = 1;
@@ -564,7 +584,9 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
   std::size_t n = 0;
 #ifdef FUSEDET_HAVE_AVX2_GRID_PATH
   if (lanes == 8) n = avx512::firstStage(sp, grids, x0, x1, y0, y1, l);
-  if (lanes == 4) n = avx2::firstStage(sp, grids, x0, x1, y0, y1, l);
+#endif
+#ifdef FUSEDET_HAVE_VECTOR_GRID_PATH
+  if (lanes == 4) n = four::firstStage(sp, grids, x0, x1, y0, y1, l);
 #endif
   if (lanes == 1) n = firstStageScalar(sp, grids, x0, x1, y0, y1, l);
   for (std::size_t s = 1; s < sp.stages.size() && n > 0; ++s) {
@@ -575,8 +597,10 @@ void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std
       n = avx512::laterStage(sp, st, grids, l, n);
       continue;
     }
+#endif
+#ifdef FUSEDET_HAVE_VECTOR_GRID_PATH
     if (lanes == 4) {
-      n = avx2::laterStage(sp, st, grids, l, n);
+      n = four::laterStage(sp, st, grids, l, n);
       continue;
     }
 #endif

@@ -38,6 +38,8 @@ int lanesFromFlags(const std::set<std::string>& f) {
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
   if (f.count("avx512f") && f.count("avx512vl")) return 8;
   if (f.count("avx2")) return 4;
+#elif defined(__aarch64__)
+  return 4;  // NEON is part of every AArch64 CPU (under qemu-user the flags are the x86 host's)
 #endif
   (void)f;
   return 1;
@@ -64,7 +66,7 @@ TEST(VectorPath, SwitchesNarrowThePath) {
   const int widest = dispatchedVectorLanes();
   setVectorLanesLimit(4);
   EXPECT_EQ(dispatchedVectorLanes(), widest >= 4 ? 4 : 1);
-  setVectorLanesLimit(2);  // no two-lane path on x86: scalar
+  setVectorLanesLimit(2);  // no two-lane path: scalar
   EXPECT_EQ(dispatchedVectorLanes(), 1);
   setVectorLanesLimit(8);
   EXPECT_EQ(dispatchedVectorLanes(), widest);
@@ -76,7 +78,11 @@ TEST(VectorPath, SwitchesNarrowThePath) {
 }
 
 TEST(VectorPath, NamesOfThePaths) {
+#if defined(__aarch64__)
+  EXPECT_EQ(vectorPathName(4), "neon");
+#else
   EXPECT_EQ(vectorPathName(8), "avx512");
   EXPECT_EQ(vectorPathName(4), "avx2");
+#endif
   EXPECT_EQ(vectorPathName(1), "scalar");
 }

@@ -6,7 +6,7 @@
 // (cascade x scale x band of window columns, every row) is shared by the threads in one index
 // space. Within a band, windows are evaluated breadth-first: stage 0 on a chunk of rows, then each
 // later stage on the compacted list of the windows that passed the one before, so that vector
-// lanes (eight windows per step with AVX-512, four with AVX2: vector_path.h; corners loaded whole
+// lanes (eight windows per step with AVX-512, four with AVX2 or NEON: vector_path.h; corners loaded whole
 // from the grids where neighbouring windows' origins are regular, else one lane at a time) stay busy although most windows leave after a stage or two. Per window the arithmetic is that of featureValue() and
 // evaluateWindow(), in the same order and precision (division, no FMA): the decisions and scores
 // are those of the one-window reference path, bit for bit (tested).
