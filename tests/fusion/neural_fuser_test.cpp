@@ -17,7 +17,6 @@
 #include "fusedet/core/dataset.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
 #include "fusedet/fusion/camera_layers.h"
-#include "fusedet/fusion/neural/coco_detections.h"
 #include "fusedet/fusion/neural/neural_layers.h"
 
 namespace fusedet::fusion {
@@ -163,36 +162,6 @@ TEST(NeuralFuser, AFailedRunAddsNothingAndSaysWhy) {
   EXPECT_EQ(failure(3), prefix + "output of a class score that is not finite");
   EXPECT_EQ(failure(4), prefix + "output of a class score outside [0, 1] (1.500000)");
   EXPECT_EQ(failure(5), prefix + "output of a box that is not finite");
-}
-
-TEST(NeuralFuser, ProposalsAreTheCnnPeersBoxesInReferencePixels) {
-  // A KITTI frame's proposals at score >= 0.1 equal coco_detections.h on a direct run of the same
-  // network, in the stack's reference pixels: here a reference grid twice the image's size.
-  const KittiFrame frame = readKittiFrame(kKitti, "000000");
-  const NeuralLayers layers(darknetOptions());
-  Network direct(networkSpecFor(darknetOptions()));
-  CocoDetectionRule rule;
-  rule.minScore = 0.1;
-  const std::vector<Detection> expected = cocoDetections(direct.run(frame.image), rule);
-  ASSERT_FALSE(expected.empty());
-  LayerStack stack(2 * frame.image.cols, 2 * frame.image.rows);
-  stack.id = 42;
-  const std::vector<Detection> got = layers.propose(stack, frame.image, rule);
-  ASSERT_EQ(got.size(), expected.size());
-  for (std::size_t i = 0; i < got.size(); ++i) {
-    EXPECT_EQ(got[i].className, expected[i].className);
-    EXPECT_EQ(got[i].score, expected[i].score);
-    EXPECT_NEAR(got[i].box.x, 2 * expected[i].box.x, 1e-9);
-    EXPECT_NEAR(got[i].box.y, 2 * expected[i].box.y, 1e-9);
-    EXPECT_NEAR(got[i].box.w, 2 * expected[i].box.w, 1e-9);
-    EXPECT_NEAR(got[i].box.h, 2 * expected[i].box.h, 1e-9);
-    EXPECT_NEAR(got[i].unitBox.x, expected[i].box.x / frame.image.cols, 1e-9);
-    EXPECT_EQ(got[i].stackId, 42u);
-  }
-  // A higher threshold gives a subset.
-  rule.minScore = 0.5;
-  EXPECT_LE(layers.propose(stack, frame.image, rule).size(), got.size());
-  EXPECT_EQ(stack.size(), 0u) << "propose adds no layer";
 }
 
 }  // namespace

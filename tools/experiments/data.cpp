@@ -13,9 +13,6 @@
 #include "fusedet/fusion/datasets/kitti_import.h"
 #include "fusedet/fusion/datasets/kitti_tracks.h"
 #include "fusedet/fusion/layer_sources.h"
-#include "fusedet/fusion/neural/neural_layers.h"
-
-#include <opencv2/core.hpp>
 
 namespace fusedet::tools::experiments {
 std::vector<fs::path> kittiDrives(const fs::path& root) {
@@ -107,34 +104,6 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
       out[i] = it->second.objectIds(driveOf[i], number, labels[i]);
   }
   return out;
-}
-
-void addProposals(const ExperimentOptions& o, std::vector<DatasetItem>& items) {
-  const std::shared_ptr<const fusion::NeuralLayers> network = o.network.load();
-  if (!network)
-    throw std::runtime_error("the configuration all_neural_proposals runs over a network's boxes: name the network "
-                             "with --network (darknet or yolov5-onnx)");
-  fusion::CocoDetectionRule rule;
-  rule.minScore = o.proposalScore;
-  std::map<std::string, std::size_t> count;
-  for (DatasetItem& item : items) {
-    std::vector<cv::Mat> bgr;
-    for (const auto name : {layer::kBlue, layer::kGreen, layer::kRed}) {
-      const Layer& l = item.stack.at(name);
-      if (l.data.type() != CV_8UC1)
-        throw std::runtime_error(item.id + ": layer " + std::string(name) + " is not 8-bit: no camera image to run " +
-                                 "the network on");
-      bgr.push_back(l.data);
-    }
-    cv::Mat image;
-    cv::merge(bgr, image);
-    item.stack.proposals = network->propose(item.stack, image, rule);
-    for (const Detection& d : item.stack.proposals) ++count[d.className];
-  }
-  std::printf("proposals %s, score >= %g: %zu car, %zu person, %zu bike on %zu frames\n",
-              network->identity().text().c_str(), o.proposalScore, count["car"], count["person"], count["bike"],
-              items.size());
-  std::fflush(stdout);
 }
 
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,

@@ -32,11 +32,6 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
 
 // Items with their raw drive as group (the folds are drive-disjoint); the network's score layers
 // too when `withNetwork`.
-// Every item's proposals (LayerStack::proposals): --network run on the item's camera layers (red,
-// green, blue), its car, person and bike boxes scoring >= --proposal-score (the CNN peer's rule
-// otherwise). Throws when --network is not given, naming the configuration that needs it.
-void addProposals(const ExperimentOptions& o, std::vector<DatasetItem>& items);
-
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
                                    const std::vector<std::string>& driveOf, bool withNetwork);
 

@@ -41,7 +41,6 @@ const std::vector<TrainedConfig>& trainedConfigs() {
       {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
       {"all_neural", poolWithNetwork(), "a-j"},
       {"neural", fusion::networkPoolLayers(), "a-j"},
-      {"all_neural_proposals", poolWithNetwork(), "a-j", true},
   };
   return c;
 }
@@ -50,18 +49,12 @@ const TrainedConfig& trainedConfig(const std::string& name) {
   for (const TrainedConfig& t : trainedConfigs())
     if (t.name == name) return t;
   throw std::runtime_error("unknown configuration '" + name +
-                           "' (all, no_corners, laser, camera, four, and, all_neural, neural, all_neural_proposals)");
+                           "' (all, no_corners, laser, camera, four, and, all_neural, neural)");
 }
 
 bool needsNetwork(const std::vector<std::string>& configs) {
   for (const std::string& c : configs)
     if (c != "and" && usesNetworkLayers(trainedConfig(c).layers)) return true;
-  return false;
-}
-
-bool needsProposals(const std::vector<std::string>& configs) {
-  for (const std::string& c : configs)
-    if (c != "and" && trainedConfig(c).proposals) return true;
   return false;
 }
 
@@ -133,13 +126,6 @@ boosting::TrainingConfig trainingConfig(const ExperimentOptions& o, const boosti
   c.samples.maxOcclusion = match.maxOcclusion;
   c.samples.scan.scaleFactor = p.trainScaleFactor;
   c.samples.scan.step = p.trainStep;
-  if (tc.proposals) {
-    c.samples.windows = boosting::WindowSearch::kProposals;
-    c.samples.proposalMinScore = o.proposalScore;
-    // The network's false alarms on the training frames are the negatives: tens per class, not the
-    // scan's thousands (person at score >= 0.1 without drive 0005: 27), so a stage trains on fewer.
-    c.minNegatives = 5;
-  }
   c.stage.maxWeak = p.maxWeak;
   if (o.training.maxFa) c.stage.maxFalseAlarm = *o.training.maxFa;
   c.stage.threads = o.threads;
@@ -229,10 +215,7 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                  "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
                  "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
                  "remission), and (laser AND camera; trains both), all_neural (all + the network's score layers "
-                 "neural_person, neural_bicycle, neural_car; needs --network), neural (the score layers alone), "
-                 "all_neural_proposals (all_neural's layers, trained on and run over the network's boxes of the "
-                 "class scoring >= --proposal-score: the network proposes, the cascade decides; its false "
-                 "alarms on the training frames are the negatives)" +
+                 "neural_person, neural_bicycle, neural_car; needs --network), neural (the score layers alone)" +
                      presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
       ->delimiter(',');
   app.add_option("--config-classes", o->configClasses,
@@ -337,11 +320,6 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
   addNetworkOptions(app, o->network,
                     "Needed by the configurations all_neural and neural: the KITTI drives are imported with the "
                     "network's layers (a cache per network).");
-  app.add_option("--proposal-score", o->proposalScore,
-                 "all_neural_proposals: the network's boxes (car, person, bike by the CNN peer's rule with this "
-                 "score threshold) that the cascades are trained on and verify")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
   app.add_option("--class-stages", o->classStagesText,
          "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
          "stages in every configuration and the learning curve (the same cascades as training with a stage "

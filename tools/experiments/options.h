@@ -63,8 +63,7 @@ struct ExperimentOptions {
   std::vector<std::size_t> stageSweep;             // stage counts the `all` fold cascades are cut to
   std::vector<int> neighborsSweep;                 // min neighbours of that sweep (default: --min-neighbors)
   bool missAnalysis = true;                        // explain every missed positive of `all`
-  NetworkOptions network;                          // the network of the all_neural, neural and proposal configurations
-  double proposalScore = 0.1;                      // all_neural_proposals: the network's boxes scoring >= this
+  NetworkOptions network;                          // the network of the all_neural and neural configurations
   std::string commandLine;
 };
 
@@ -73,9 +72,6 @@ struct TrainedConfig {
   std::string name;
   std::vector<std::string> layers;
   std::string types;  // feature letters
-  // Trained on and run over the network's proposals (fusedet/boost/proposal_windows.h) scoring
-  // >= --proposal-score instead of every window of a scan.
-  bool proposals = false;
 };
 
 const std::vector<TrainedConfig>& trainedConfigs();
@@ -84,8 +80,6 @@ const TrainedConfig& trainedConfig(const std::string& name);
 
 // Whether any configuration of the plan trains on the network's score layers.
 bool needsNetwork(const std::vector<std::string>& configs);
-// Whether any configuration of the plan runs over the network's proposals.
-bool needsProposals(const std::vector<std::string>& configs);
 
 // "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).
 std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option);

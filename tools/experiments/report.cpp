@@ -82,8 +82,6 @@ const std::vector<ConfigInfo>& paperConfigs() {
       {"and", "Tab. 7: laser-only AND camera-only cascade (Tab. 4 AND Tab. 5; a detection must pass both)"},
       {"all_neural", "issue 30: all layers and the network's score layers (neural_person, neural_bicycle, neural_car), features a-j"},
       {"neural", "issue 30: the network's score layers alone, features a-j"},
-      {"all_neural_proposals", "issue 30: all_neural's layers, trained on and run over the network's boxes of the class "
-                               "(--proposal-score): the network proposes, the cascade decides"},
   };
   return c;
 }

@@ -139,7 +139,6 @@ int runExperiments(ExperimentOptions o) {
   std::fflush(stdout);
 
   std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf, withNetwork);
-  if (needsProposals(configs)) addProposals(o, items);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -386,7 +385,7 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if ((config == "all" || config == "all_neural" || config == "all_neural_proposals") && !r.layerWeightShare.empty())
+    if ((config == "all" || config == "all_neural") && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
   };

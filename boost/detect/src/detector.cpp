@@ -71,17 +71,7 @@ Detector::~Detector() = default;
 Detector::Detector(Detector&&) noexcept = default;
 Detector& Detector::operator=(Detector&&) noexcept = default;
 
-namespace {
-void requireSliding(const Cascade& c) {
-  if (c.windows == WindowSearch::kProposals)
-    throw std::invalid_argument((c.source.empty() ? c.className : c.source) +
-                                ": the model verifies a network's proposals (windows: proposals); it does not scan "
-                                "every window (proposal_windows.h verifyProposals)");
-}
-}  // namespace
-
 std::vector<RawHit> Detector::scan(const LayerStack& stack, const ScanParams& params, ScanStats* stats) const {
-  requireSliding(cascade_);
   if (cascade_.isOpenCv()) return scanOpenCvPyramid(cascade_, stack, params, stats);
   const IntegralGrids grids(stack, layerRequests(cascade_), params.threads);
   std::vector<ScanStats> st;
@@ -95,7 +85,6 @@ std::vector<RawHit> Detector::scan(const LayerStack& stack, const ScanParams& pa
 }
 
 std::vector<RawHit> Detector::scan(const IntegralStack& in, const ScanParams& params, ScanStats* stats) const {
-  requireSliding(cascade_);
   if (cascade_.isOpenCv())
     throw std::invalid_argument("Detector::scan: OpenCV models scan a LayerStack (their own pyramid)");
   if (in.size() != cascade_.layers.size())

@@ -10,13 +10,7 @@
 namespace fusedet::boosting {
 
 MultiDetector::MultiDetector(std::vector<Cascade> cascades) : cascades_(std::move(cascades)) {
-  for (const Cascade& c : cascades_) {
-    c.validate();
-    if (c.windows == WindowSearch::kProposals)
-      throw std::invalid_argument((c.source.empty() ? c.className : c.source) +
-                                  ": the model verifies a network's proposals (windows: proposals); a one-pass "
-                                  "scan of every class runs sliding-window models only");
-  }
+  for (const Cascade& c : cascades_) c.validate();
 }
 
 std::vector<std::vector<RawHit>> MultiDetector::scan(const LayerStack& stack, const ScanParams& params,

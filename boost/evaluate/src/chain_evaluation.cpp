@@ -6,7 +6,6 @@
 #include <stdexcept>
 
 #include "fusedet/boost/integral_stack.h"
-#include "fusedet/boost/proposal_windows.h"
 
 namespace fusedet::boosting {
 
@@ -15,12 +14,6 @@ std::vector<Detection> detectChain(const std::vector<const Detector*>& chain, co
                                    const DetectionSetup& setup, ScanStats* stats) {
   if (chain.empty()) throw std::invalid_argument("detectChain: no cascade given");
   const Detector& first = *chain.front();
-  if (first.cascade().windows == WindowSearch::kProposals) {
-    // The network's boxes, verified: no scan, no grouping, no box refinement.
-    std::vector<const Cascade*> cascades;
-    for (const Detector* d : chain) cascades.push_back(&d->cascade());
-    return verifyProposals(cascades, stack, stats);
-  }
   std::vector<RawHit> hits = first.scan(stack, setup.scan, stats);
   for (std::size_t k = 1; k < chain.size() && !hits.empty(); ++k) {
     const Cascade& c = chain[k]->cascade();

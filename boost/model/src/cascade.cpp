@@ -74,11 +74,6 @@ void Cascade::validate() const {
       if (!std::isfinite(q.weight)) fail("feature " + std::to_string(i) + " has a non-finite weight");
     }
   }
-  if (windows == WindowSearch::kProposals) {
-    if (isOpenCv()) fail("an OpenCV cascade cannot verify proposals");
-    if (!(proposalMinScore >= 0 && proposalMinScore <= 1))
-      fail("minimum proposal score " + std::to_string(proposalMinScore) + " is not in [0, 1]");
-  }
   const bool trees = hasTrees();
   if (trees && !isOpenCv()) fail("decision trees are only supported in imported OpenCV cascades");
   if (trees && treeStages.size() != stages.size())

@@ -101,9 +101,6 @@ std::string modelToText(const Cascade& c, const ModelInfo& info) {
   o << "  \"layers\": " << Json(c.layers).dump() << ",\n";
   o << "  \"reference_hue\": " << (c.referenceHue ? Json(*c.referenceHue) : Json(nullptr)).dump() << ",\n";
   if (!c.network.empty()) o << "  \"network\": " << Json(c.network.text()).dump() << ",\n";
-  // Only for proposal cascades: sliding-window models stay as they were.
-  if (c.windows == WindowSearch::kProposals)
-    o << "  \"windows\": " << Json{{"search", "proposals"}, {"min_score", c.proposalMinScore}}.dump() << ",\n";
   if (!info.empty()) {
     Json t = Json::object();
     for (const auto& [k, v] : info) t[k] = v;
@@ -176,18 +173,6 @@ Cascade modelFromText(const std::string& text, const std::string& source) {
       c.network = parseNetworkRecord(r.string(root, "", "network"));
     } catch (const std::invalid_argument& e) {
       r.fail("network", e.what());
-    }
-  }
-  if (root.contains("windows")) {
-    const Json& w = r.field(root, "", "windows");
-    const std::string search = r.string(w, "windows", "search");
-    if (search == "proposals") {
-      c.windows = WindowSearch::kProposals;
-      c.proposalMinScore = r.number(w, "windows", "min_score");
-      if (!(c.proposalMinScore >= 0 && c.proposalMinScore <= 1))
-        r.fail("windows.min_score", "must be in [0, 1]");
-    } else if (search != "sliding") {
-      r.fail("windows.search", "'" + search + "' is not a window search (sliding or proposals)");
     }
   }
   // Written by --min-height-from-positives, removed (a tie cross-drive): such a model would now scan

@@ -49,8 +49,6 @@ void TrainingConfig::validate() const {
   if (samples.baseWindowHeight < 4) bad("window height must be >= 4 pixels");
   if (!(samples.scan.scaleFactor > 1)) bad("scan scale factor must be > 1");
   if (!(samples.scan.step > 0)) bad("scan step must be > 0");
-  if (!(samples.proposalMinScore >= 0 && samples.proposalMinScore <= 1)) bad("minimum proposal score must be in [0, 1]");
-  if (!(samples.proposalPositiveIou > 0 && samples.proposalPositiveIou <= 1)) bad("proposal positive IoU must be in (0, 1]");
 }
 
 double classReferenceHue(const std::vector<DatasetItem>& items, const SampleConfig& samples) {
@@ -118,8 +116,6 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
   cascade.layers = layers;
   if (usesNetworkLayers(layers)) cascade.network = networkOfItems(train);
   cascade.referenceHue = refHue;
-  cascade.windows = config.samples.windows;
-  cascade.proposalMinScore = config.samples.proposalMinScore;
   cascade.windowHeight = config.samples.baseWindowHeight;
   cascade.windowWidth = std::max(
       4, static_cast<int>(std::lround(config.samples.baseWindowHeight * stacks.positiveAspect())));
@@ -151,11 +147,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     progress.onProgress(e);
   }
 
-  // The incremental miner keeps every scan window per stack: sliding-window training only (a
-  // proposal cascade's few windows are evaluated whole each stage).
-  const bool incremental = config.incrementalMining && config.samples.windows == WindowSearch::kSliding;
-  std::optional<NegativeMiner> miner;
-  if (incremental) miner.emplace(stacks);
+  NegativeMiner miner(stacks);
   std::optional<PositiveFeatures> positiveValues;  // built at the first stage
   std::map<std::size_t, int> cascadeIndex;  // pool feature -> Cascade::features index
   std::size_t initialCandidates = 0;
@@ -170,7 +162,7 @@ Cascade trainCascade(const TrainingConfig& configIn, const std::vector<DatasetIt
     const std::size_t want = stage > config.maxStages ? 0 : wanted;
     const std::uint64_t seed = config.seed * 1000003ULL + std::uint64_t(stage);
     const NegativeHarvest harvest = job ? shardedHarvest(stacks, cascade, want, seed, config.threads, *job)
-                                        : incremental ? miner->harvest(cascade, want, seed, config.threads)
+                                        : config.incrementalMining ? miner.harvest(cascade, want, seed, config.threads)
                                                                    : stacks.harvestNegatives(cascade, want, seed, config.threads);
     const double harvestSeconds = std::chrono::duration<double>(Clock::now() - ts).count();
     if (stage == 1) initialCandidates = std::max<std::size_t>(1, harvest.candidates);

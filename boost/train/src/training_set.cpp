@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/boost/training_set.h"
 #include "fusedet/boost/parallel_for.h"
-#include "fusedet/boost/proposal_windows.h"
 
 #include <opencv2/core.hpp>
 #include <tbb/blocked_range.h>
@@ -71,11 +70,6 @@ DatasetItem flipItem(const DatasetItem& item) {
     if (l.hasMask()) cv::flip(l.valid, m.valid, 1);
     out.stack.set(std::move(m));
   }
-  out.stack.proposals = item.stack.proposals;
-  for (Detection& p : out.stack.proposals) {
-    p.box.x = item.stack.width() - p.box.x - p.box.w;
-    p.unitBox = out.stack.toUnit(p.box);
-  }
   out.labels = flippedLabels(item);
   return out;
 }
@@ -90,12 +84,6 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
   std::vector<std::pair<std::size_t, bool>> source;  // item index, mirrored
   for (std::size_t i = 0; i < items.size(); ++i) source.emplace_back(i, false);
   originals_ = items.size();
-  if (config_.windows == WindowSearch::kProposals)
-    for (const DatasetItem& item : items) {
-      std::vector<Box>& boxes = proposals_.emplace_back();
-      for (const ProposalWindow& w : proposalWindows(item.stack, config_.className, config_.proposalMinScore))
-        boxes.push_back(w.box);
-    }
   for (std::size_t i = 0; i < items.size(); ++i)
     if (std::any_of(items[i].labels.begin(), items[i].labels.end(),
                     [&](const Label& l) { return isPositiveLabel(l, config_); }))
@@ -107,16 +95,6 @@ TrainingStacks::TrainingStacks(const std::vector<DatasetItem>& items,
     if (mirrored) labels = flippedLabels(items[i]);
     for (const Label& l : labels)
       if (isPositiveLabel(l, config_)) positives_.push_back(Sample{static_cast<std::uint32_t>(k), l.box});
-    // Proposals: the network's boxes on a positive are positives too (detection verifies such boxes,
-    // not the labels' framing).
-    if (config_.windows == WindowSearch::kProposals)
-      for (Box b : proposals_[i]) {
-        if (mirrored) b.x = items[i].stack.width() - b.x - b.w;
-        if (std::any_of(labels.begin(), labels.end(), [&](const Label& l) {
-              return isPositiveLabel(l, config_) && iou(b, l.box) >= config_.proposalPositiveIou;
-            }))
-          positives_.push_back(Sample{static_cast<std::uint32_t>(k), b});
-      }
     labels_.push_back(std::move(labels));
   }
   integrals_.resize(source.size());
@@ -170,15 +148,6 @@ Detector TrainingStacks::harvestDetector(const Cascade& cascade) {
 
 std::vector<Box> TrainingStacks::candidateWindows(const Detector& detector, std::size_t s, int threads,
                                                   std::size_t* scanned) const {
-  if (config_.windows == WindowSearch::kProposals) {
-    const NegativeWindowTest labelFree(labels_.at(s), config_);
-    std::vector<Box> out;
-    for (const Box& box : proposals_.at(s)) {
-      ++*scanned;
-      if (labelFree(box) && evaluateWindow(detector.cascade(), integrals_.at(s), box).accepted) out.push_back(box);
-    }
-    return out;
-  }
   ScanParams params = config_.scan;
   params.threads = threads;
   ScanStats stats;

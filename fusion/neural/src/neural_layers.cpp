@@ -61,7 +61,7 @@ NeuralLayers::NeuralLayers(const NeuralLayerOptions& options, NetworkRun run)
   if (!run_) run_ = [](Network& n, const cv::Mat& bgr) { return n.run(bgr); };
 }
 
-Anchors NeuralLayers::run(const LayerStack& stack, const cv::Mat& bgr) const {
+void NeuralLayers::add(LayerStack& stack, const cv::Mat& bgr) const {
   if (stack.width() < 1 || stack.height() < 1)
     throw std::invalid_argument("neural layers: the stack has no reference size");
   Anchors anchors;
@@ -86,23 +86,8 @@ Anchors NeuralLayers::run(const LayerStack& stack, const cv::Mat& bgr) const {
   const double sx = static_cast<double>(stack.width()) / bgr.cols, sy = static_cast<double>(stack.height()) / bgr.rows;
   if (sx != 1.0 || sy != 1.0)
     for (Box& b : anchors.boxes) b = Box{b.x * sx, b.y * sy, b.w * sx, b.h * sy};
-  return anchors;
-}
-
-void NeuralLayers::add(LayerStack& stack, const cv::Mat& bgr) const {
-  addScoreLayers(stack, run(stack, bgr), scale_);
+  addScoreLayers(stack, anchors, scale_);
   stack.network = record();
-}
-
-std::vector<Detection> NeuralLayers::propose(const LayerStack& stack, const cv::Mat& bgr,
-                                             const CocoDetectionRule& rule) const {
-  std::vector<Detection> out = cocoDetections(run(stack, bgr), rule);
-  for (Detection& d : out) {
-    d.unitBox = stack.toUnit(d.box);
-    d.stamp = stack.stamp;
-    d.stackId = stack.id;
-  }
-  return out;
 }
 
 std::vector<std::string> NeuralLayers::layerNames() const {

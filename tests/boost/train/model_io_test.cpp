@@ -71,29 +71,6 @@ TEST(ModelIo, RoundTripIsExactAndTextIsStable) {
   EXPECT_NE(text.find("\"type\":\"g\""), std::string::npos);
 }
 
-TEST(ModelIo, AProposalCascadesWindowSearchIsRecorded) {
-  Cascade c = sample();
-  EXPECT_EQ(modelToText(c, {}).find("windows"), std::string::npos) << "sliding-window models stay as they were";
-  c.windows = WindowSearch::kProposals;
-  c.proposalMinScore = 0.125;
-  const std::string text = modelToText(c, {});
-  EXPECT_NE(text.find("\"windows\": {\"search\":\"proposals\",\"min_score\":0.125}"), std::string::npos) << text;
-  const Cascade back = modelFromText(text, "m.json");
-  EXPECT_EQ(back.windows, WindowSearch::kProposals);
-  EXPECT_EQ(back.proposalMinScore, 0.125);
-  EXPECT_EQ(modelToText(back, {}), text);
-  const auto edited = [&](const std::string& from, const std::string& to) {
-    std::string t = text;
-    t.replace(t.find(from), from.size(), to);
-    return errorOf(t);
-  };
-  EXPECT_EQ(edited("\"search\":\"proposals\"", "\"search\":\"grid\""),
-            "m.json: windows.search: 'grid' is not a window search (sliding or proposals)");
-  EXPECT_EQ(edited("\"min_score\":0.125", "\"min_score\":1.5"), "m.json: windows.min_score: must be in [0, 1]");
-  EXPECT_EQ(edited(",\"min_score\":0.125", ""), "m.json: windows.min_score: missing");
-  EXPECT_EQ(modelFromText(replace(text, "\"proposals\"", "\"sliding\""), "m.json").windows, WindowSearch::kSliding);
-}
-
 TEST(ModelIo, TheNetworkOfNeuralLayersIsRecordedAndChecked) {
   Cascade c = sample();
   EXPECT_EQ(modelToText(c).find("\"network\""), std::string::npos);  // no neural layers: no key

@@ -53,7 +53,6 @@ std::string describeTrainingConfig(const TrainingConfig& c) {
     << " min_positives " << c.minPositives << " seed " << c.seed << "\n";
   // Only when set: keys of configurations without them stay as they were.
   if (!c.samples.ignoreClasses.empty()) d << "ignore_classes " << joined(c.samples.ignoreClasses) << "\n";
-  if (c.samples.windows == WindowSearch::kProposals) d << "windows proposals " << c.samples.proposalMinScore << " positive_iou " << c.samples.proposalPositiveIou << "\n";
   return d.str();
 }
 

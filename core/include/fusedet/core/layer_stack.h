@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "fusedet/core/box.h"
-#include "fusedet/core/detection.h"
 #include "fusedet/core/network_record.h"
 #include "fusedet/core/stamp.h"
 
@@ -73,10 +72,6 @@ class LayerStack {
   Stamp stamp;           // time of the camera frame the stack was built from
   std::string source;    // where it came from, e.g. "kitti/000042" or "live"
   NetworkRecord network;  // the network that made its neural_* layers (empty: none)
-  // Boxes a detector network proposed on this stack (class, score, box in reference pixels;
-  // fusion/neural NeuralLayers::propose): the windows a cascade trained on proposals verifies
-  // (fusedet/boost/proposal_windows.h). Empty: none.
-  std::vector<Detection> proposals;
 
  private:
   std::vector<Layer> layers_;

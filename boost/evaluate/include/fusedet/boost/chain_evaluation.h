@@ -4,7 +4,6 @@
 // `fusedet eval`, `fusedet train --eval` and `fusedet experiments` share). A chain of several
 // cascades is their AND combination (paper Tab. 7): the first one scans every window, each later
 // one must also accept a window it passed, then the surviving windows are grouped into detections.
-// Cascades trained on proposals verify the stack's proposals instead (proposal_windows.h).
 
 #include <cstddef>
 #include <vector>

@@ -28,11 +28,6 @@
 
 namespace fusedet::boosting {
 
-// Which windows a cascade runs on: every window of a scan (sliding), or the boxes a detector
-// network proposed for its class (LayerStack::proposals; proposal_windows.h): the network
-// proposes, the cascade over the joint pool decides (issue 30).
-enum class WindowSearch { kSliding, kProposals };
-
 enum class Normalization {
   kNone,            // feature value as is (our models)
   kOpenCvVariance,  // OpenCV: value / (window stddev * area), on an image pyramid of one layer
@@ -80,8 +75,6 @@ struct Cascade {
   std::vector<std::string> layers;          // layer names the features index
   std::optional<double> referenceHue;       // degrees, for a "hue_distance" layer
   NetworkRecord network;                    // the network that made its neural_* layers (empty: none)
-  WindowSearch windows = WindowSearch::kSliding;
-  double proposalMinScore = 0;  // kProposals: the stack's proposals of the class scoring >= this
   Normalization normalization = Normalization::kNone;
   std::vector<Feature> features;          // kNone
   std::vector<HaarFeature> haarFeatures;  // kOpenCvVariance
@@ -102,8 +95,7 @@ struct Cascade {
   // feature index out of range, non-finite threshold or leaf, rectangle outside the window, layer
   // index out of range, hue_distance without a reference hue, OpenCV model without one layer,
   // trees in one of our models, a tree stage count other than the stage count, a stage mixing
-  // stumps and trees, a tree whose children do not follow their parent, a proposal cascade that is
-  // an OpenCV model or whose minimum proposal score is not in [0, 1].
+  // stumps and trees, a tree whose children do not follow their parent.
   void validate() const;
 };
 

@@ -38,13 +38,6 @@ struct SampleConfig {
   std::vector<std::string> ignoreClasses;  // e.g. {"van"} for car: KITTI's neighbouring class
   int baseWindowHeight = 24;  // model window height in pixels; width from the positives' aspect
   ScanParams scan;            // windows scanned for negatives (scales, step)
-  // kProposals: the negatives come from the training stacks' proposals of the class
-  // (proposal_windows.h: scoring >= proposalMinScore) instead of a scan - the windows detection
-  // will verify, so the network's false alarms on the training frames are the hard negatives.
-  // Proposals overlapping a positive label by IoU >= proposalPositiveIou are positives too.
-  WindowSearch windows = WindowSearch::kSliding;
-  double proposalMinScore = 0;
-  double proposalPositiveIou = 0.5;
 };
 
 struct Sample {
@@ -121,9 +114,8 @@ class TrainingStacks {
 
   // The detector the harvest scans with (one accepting every window while `cascade` is empty).
   static Detector harvestDetector(const Cascade& cascade);
-  // Label-free windows of original stack s that `detector` accepts, in scan order (with
-  // SampleConfig::windows kProposals: of its proposal windows, in their order); adds the windows
-  // visited to *scanned.
+  // Label-free windows of original stack s that `detector` accepts, in scan order; adds the
+  // windows visited to *scanned.
   std::vector<Box> candidateWindows(const Detector& detector, std::size_t s, int threads,
                                     std::size_t* scanned) const;
 
@@ -131,7 +123,6 @@ class TrainingStacks {
   std::vector<IntegralStack> integrals_;  // empty for stacks of other ranks
   std::vector<int> owner_;
   std::vector<Labels> labels_;  // per stack (mirrored for flipped copies)
-  std::vector<std::vector<Box>> proposals_;  // per original stack, with SampleConfig::windows kProposals
   std::vector<Sample> positives_;
   std::size_t originals_ = 0;
   SampleConfig config_;
@@ -139,7 +130,7 @@ class TrainingStacks {
 };
 
 
-// Horizontally mirrored copy of a stack (every layer and mask, its proposals) and its labels.
+// Horizontally mirrored copy of a stack (every layer and mask) and its labels.
 DatasetItem flipItem(const DatasetItem& item);
 // The labels of flipItem(item) alone.
 Labels flippedLabels(const DatasetItem& item);

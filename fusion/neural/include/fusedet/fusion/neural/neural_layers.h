@@ -19,8 +19,6 @@
 #include <vector>
 
 #include "fusedet/core/layer_stack.h"
-#include "fusedet/core/detection.h"
-#include "fusedet/fusion/neural/coco_detections.h"
 #include "fusedet/fusion/neural/network.h"
 #include "fusedet/fusion/neural/score_layers.h"
 
@@ -60,11 +58,6 @@ class NeuralLayers {
   // anchor rows and classes; every score finite and in [0, 1], every box finite).
   void add(LayerStack& stack, const cv::Mat& bgr) const;
 
-  // The network's car, person and bike boxes on `bgr` (coco_detections.h with `rule`), in
-  // `stack`'s reference pixels with its stamp and id: the proposals a cascade trained on them
-  // verifies (LayerStack::proposals, fusedet/boost/proposal_windows.h). Runs and fails as add().
-  std::vector<Detection> propose(const LayerStack& stack, const cv::Mat& bgr, const CocoDetectionRule& rule) const;
-
   const NetworkIdentity& identity() const { return network_.identity(); }
   NetworkRecord record() const { return network_.identity().record(); }
   // The layers add() makes, in its order.
@@ -74,9 +67,6 @@ class NeuralLayers {
   int threads() const { return network_.spec().threads; }
 
  private:
-  // One checked run on `bgr`, its boxes in `stack`'s reference pixels.
-  Anchors run(const LayerStack& stack, const cv::Mat& bgr) const;
-
   mutable std::mutex mutex_;
   mutable Network network_;
   NetworkRun run_;
