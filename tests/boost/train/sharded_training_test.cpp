@@ -197,3 +197,17 @@ TEST(FeatureMatrix, BinsWithGivenEdgesCountTheEdgesBelow) {
   EXPECT_EQ(bins, (std::vector<int>{0, 1, 1, 2, 3, 3}));
   EXPECT_THROW(m.setFeature(0, values, std::vector<float>(256, 0.f)), std::out_of_range);
 }
+
+// Nothing to gather or scatter (a rank that picked no window): empty results, and no null pointer
+// handed to memcpy - UBSan stopped ShardedTraining.SameModelForOneTwoAndThreeRanks there
+// (scripts/sanitize asan, docs/reliability.md).
+TEST(Collective, GatheringAndScatteringNothingGivesNothing) {
+  fusedet::boosting::LocalCollective local;
+  const std::vector<int> none;
+  EXPECT_TRUE(fusedet::boosting::allGatherValues<int>(local, none).empty());
+  const std::vector<int> three{1, 2, 3};
+  EXPECT_EQ(fusedet::boosting::allGatherValues<int>(local, three), three);
+  std::vector<std::int32_t> mine;
+  local.reduceScatterSum({}, {}, mine);
+  EXPECT_TRUE(mine.empty());
+}

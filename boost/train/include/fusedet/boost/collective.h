@@ -44,7 +44,7 @@ class LocalCollective final : public Collective {
   void allReduceSum(std::span<std::int64_t>) override {}
   void reduceScatterSum(std::span<const std::int32_t> data, std::span<const int>,
                         std::span<std::int32_t> mine) override {
-    std::memcpy(mine.data(), data.data(), mine.size_bytes());
+    if (!mine.empty()) std::memcpy(mine.data(), data.data(), mine.size_bytes());  // no null pointer to memcpy
   }
   std::vector<std::byte> allGather(std::span<const std::byte> mine) override {
     return {mine.begin(), mine.end()};
@@ -58,7 +58,8 @@ std::vector<T> allGatherValues(Collective& c, std::span<const T> mine) {
   static_assert(std::is_trivially_copyable_v<T>);
   const std::vector<std::byte> bytes = c.allGather(std::as_bytes(mine));
   std::vector<T> out(bytes.size() / sizeof(T));
-  std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
+  // Nothing gathered: out.data() may be null, which memcpy must not get even for 0 bytes (UBSan).
+  if (!out.empty()) std::memcpy(out.data(), bytes.data(), out.size() * sizeof(T));
   return out;
 }
 
