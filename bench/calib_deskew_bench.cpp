@@ -43,12 +43,7 @@ struct DriveFrames {
 Eigen::Matrix<double, 6, 1> edgePeaks(const CalibFrame& frame, const Eigen::Matrix3d& K, const Eigen::Isometry3d& reference) {
   const ScoreProfile p = scoreProfile({frame}, K, reference);
   Eigen::Matrix<double, 6, 1> peak;
-  for (int a = 0; a < 6; ++a) {
-    int best = 0;
-    for (int k = 1; k < static_cast<int>(p.scores[a].size()); ++k)
-      if (p.scores[a][static_cast<std::size_t>(k)].edgeAlignment > p.scores[a][static_cast<std::size_t>(best)].edgeAlignment) best = k;
-    peak(a) = p.offset(a, best - p.steps) * (a < 3 ? 1.0 : 100.0);
-  }
+  for (int a = 0; a < 6; ++a) peak(a) = p.peakOffset(a, false) * (a < 3 ? 1.0 : 100.0);
   return peak;
 }
 

@@ -29,6 +29,17 @@ ScoreProfile scoreProfile(const std::vector<CalibFrame>& frames, const Eigen::Ma
   return p;
 }
 
+double ScoreProfile::peakOffset(int axis, bool mutualInformation) const {
+  auto value = [&](int k) {
+    const AlignmentScore& s = scores[axis][static_cast<std::size_t>(k + steps)];
+    return mutualInformation ? s.mutualInformation : s.edgeAlignment;
+  };
+  int best = -steps;  // the first of equal values, as the search from -steps up finds it
+  for (int k = -steps; k <= steps; ++k)
+    if (value(k) > value(best)) best = k;
+  return offset(axis, best);
+}
+
 std::string formatScoreProfile(const ScoreProfile& p) {
   const char* names[] = {"rot_x", "rot_y", "rot_z", "t_x", "t_y", "t_z"};
   std::string out;
@@ -50,10 +61,8 @@ std::string formatScoreProfile(const ScoreProfile& p) {
     }
     out += "peak at    ";
     for (int axis = 0; axis < 6; ++axis) {
-      int best = -p.steps;
-      for (int k = -p.steps; k <= p.steps; ++k)
-        if (value(axis, k) > value(axis, best)) best = k;
-      out += (std::snprintf(buf, sizeof buf, " %9.2f", axis < 3 ? p.offset(axis, best) : 100 * p.offset(axis, best)), buf);
+      const double peak = p.peakOffset(axis, m == 1);
+      out += (std::snprintf(buf, sizeof buf, " %9.2f", axis < 3 ? peak : 100 * peak), buf);
     }
     out += "\n";
   }

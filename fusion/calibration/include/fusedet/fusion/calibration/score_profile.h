@@ -18,6 +18,8 @@ struct ScoreProfile {
   double rotationStepDeg = 0, translationStep = 0;  // [deg], [m]
   std::vector<AlignmentScore> scores[6];            // per axis: rot_x rot_y rot_z t_x t_y t_z; 2 x steps + 1 each
   double offset(int axis, int k) const { return k * (axis < 3 ? rotationStepDeg : translationStep); }
+  // Offset [deg or m] at which the edge measure (or mutual information) is largest along the axis.
+  double peakOffset(int axis, bool mutualInformation) const;
 };
 ScoreProfile scoreProfile(const std::vector<CalibFrame>& frames, const Eigen::Matrix3d& K, const Eigen::Isometry3d& reference,
                           int steps = 20, double rotationStepDeg = 0.05, double translationStep = 0.005,
