@@ -115,12 +115,17 @@ double integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
 thread_local std::vector<std::vector<double>> tBuffers;
 thread_local std::vector<std::vector<std::int32_t>> tIntBuffers;
 
+// The pooled buffer of n values if there is one (the next stack has the same sizes), else the
+// last: a buffer of another grid's size would be grown by resize(), which zeroes what it adds -
+// megabytes per stack when a camera-size grid took the laser grid's buffer.
 template <class T>
 std::vector<T> takeBuffer(std::vector<std::vector<T>>& pool, std::size_t n) {
   std::vector<T> b;
   if (!pool.empty()) {
-    b = std::move(pool.back());
-    pool.pop_back();
+    auto it = std::find_if(pool.begin(), pool.end(), [&](const std::vector<T>& p) { return p.size() == n; });
+    if (it == pool.end()) it = pool.end() - 1;
+    b = std::move(*it);
+    pool.erase(it);
   }
   b.resize(n);
   return b;
