@@ -15,9 +15,11 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <tuple>
 
 #include "fusedet/boost/model_io.h"
 #include "fusedet/boost/integral_grids.h"
+#include "fusedet/boost/integral_stack.h"
 #include "fusedet/boost/opencv_cascade.h"
 #include "fusedet/boost/vector_path.h"
 #include "fusedet/core/hue_distance.h"
@@ -198,6 +200,46 @@ TEST(IntegralGrids, BoundsAreEachLayersLargestMagnitude) {
   f.at<float>(40, 60) = std::numeric_limits<float>::quiet_NaN();
   const IntegralGrids withNan(s, {{"distance", {}}}, 1);
   EXPECT_TRUE(std::isnan(withNan.grids().front().bounds.front()));
+}
+
+// The tables hold integrateLayer()'s values, bit for bit: two 8-bit layers (int32 tables, widths
+// with and without a remainder of four columns) and a float layer of another grid, on stacks of
+// two sizes one after the other and the first again (the tables' buffers are reused between them).
+TEST(IntegralGrids, TablesEqualIntegrateLayerOnStacksOfOtherSizes) {
+  auto stackOf = [](int w, int h, int seed) {
+    cv::setRNGSeed(seed);
+    LayerStack s(w, h);
+    cv::Mat red(h, w, CV_8UC1), green(h, w, CV_8UC1), distance(h / 2, w / 2 + 1, CV_32FC1);
+    cv::randu(red, 0, 256);
+    cv::randu(green, 0, 256);
+    red.at<std::uint8_t>(h - 1, w - 1) = 255;
+    cv::randu(distance, -30.f, 80.f);
+    s.set(Layer{"red", red, {}});
+    s.set(Layer{"green", green, {}});
+    s.set(Layer{"distance", distance, {}});
+    return s;
+  };
+  const std::vector<LayerRequest> requests{{"red", {}}, {"green", {}}, {"distance", {}}};
+  for (const auto& [w, h, seed] : {std::tuple{67, 41, 1}, std::tuple{128, 96, 2}, std::tuple{67, 41, 3}}) {
+    const LayerStack s = stackOf(w, h, seed);
+    const IntegralGrids grids(s, requests, 1);
+    for (const LayerRequest& r : requests) {
+      const SlotRef ref = grids.find(r);
+      const IntegralGrid& g = grids.grids()[static_cast<std::size_t>(ref.grid)];
+      const LayerIntegral want = integrateLayer(r.name, s.at(r.name).data);
+      ASSERT_EQ(g.width, want.width);
+      ASSERT_EQ(g.height, want.height);
+      EXPECT_EQ(g.exactInt, r.name != "distance");
+      std::size_t differ = 0;
+      for (int y = 0; y <= g.height; ++y)
+        for (int x = 0; x <= g.width; ++x) {
+          const std::ptrdiff_t at = y * g.pitch + ref.slot * g.stride + x;
+          const double have = g.exactInt ? double(g.idata[static_cast<std::size_t>(at)]) : g.data[static_cast<std::size_t>(at)];
+          differ += have == want.sum[static_cast<std::size_t>(y * want.stride() + x)] ? 0 : 1;
+        }
+      EXPECT_EQ(differ, 0u) << r.name << " on the " << w << "x" << h << " stack";
+    }
+  }
 }
 
 // The optimised scanner (one pass, widest vector path, quick stump decisions, branch-free survivor
