@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <string>
 #include <thread>
 
 #include "fusedet/daemon/client.h"
@@ -64,6 +65,17 @@ Received follow(const std::string& path, std::size_t count, std::chrono::millise
     if (pause.count()) std::this_thread::sleep_for(pause);
   }
   return got;
+}
+
+// What a client got against 0..count-1, for a failure message: how many, up to where in order, the
+// first id out of place, and whether the server closed the connection (dropped it as slow).
+std::string describe(const Received& got, std::size_t count) {
+  std::size_t inOrder = 0;
+  while (inOrder < got.ids.size() && got.ids[inOrder] == inOrder) ++inOrder;
+  std::string s = std::to_string(got.ids.size()) + " of " + std::to_string(count) + " results, the first " +
+                  std::to_string(inOrder) + " in order";
+  if (inOrder < got.ids.size()) s += ", then id " + std::to_string(got.ids[inOrder]);
+  return s + (got.closed ? ", closed by the server" : "");
 }
 
 }  // namespace
@@ -145,9 +157,9 @@ TEST(Server, FiftyMixedClientsNoneStallsAndKeepersGetEverything) {
   EXPECT_LT(publishS, 8.0);
   std::vector<std::uint64_t> all(kResults);
   for (std::size_t i = 0; i < kResults; ++i) all[i] = i;
-  for (const auto& r : normal) EXPECT_EQ(r.ids, all);
+  for (const auto& r : normal) EXPECT_TRUE(r.ids == all) << describe(r, kResults);
   for (const auto& r : filtered) {
-    EXPECT_EQ(r.ids, all);
+    EXPECT_TRUE(r.ids == all) << describe(r, kResults);
     EXPECT_TRUE(r.classesOk);
   }
   for (const auto& r : slow) {
