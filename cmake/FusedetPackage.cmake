@@ -60,6 +60,25 @@ set(CPACK_DEBIAN_PACKAGE_PRIORITY optional)
 # Library dependencies come from dpkg-shlibdeps; the maintainer scripts need systemd-sysusers and
 # deb-systemd-helper.
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# A cross build (the arm64 package, docs/packaging.md) is packed for the target's Debian
+# architecture, and dpkg-shlibdeps reads the target's libraries: those of the sysroot, with their
+# packages and symbols files from a dpkg database of the sysroot's packages (scripts/arm64-sysroot
+# makes var/lib/dpkg-shlibdeps), set for the cpack run by cmake/deb/cross.cmake.
+if(CMAKE_CROSSCOMPILING)
+  set(FUSEDET_SHLIBDEPS_ADMINDIR "${CMAKE_SYSROOT}/var/lib/dpkg-shlibdeps" CACHE PATH
+      "Cross builds: the dpkg database (status, info/*.list, *.shlibs, *.symbols) of the sysroot's packages, for dpkg-shlibdeps")
+  execute_process(COMMAND dpkg-architecture -t${CMAKE_LIBRARY_ARCHITECTURE} -qDEB_HOST_ARCH
+                  OUTPUT_VARIABLE CPACK_DEBIAN_PACKAGE_ARCHITECTURE OUTPUT_STRIP_TRAILING_WHITESPACE ERROR_QUIET
+                  RESULT_VARIABLE _rc)
+  if(NOT _rc EQUAL 0 OR NOT CPACK_DEBIAN_PACKAGE_ARCHITECTURE)
+    message(FATAL_ERROR "dpkg-architecture knows no Debian architecture for '${CMAKE_LIBRARY_ARCHITECTURE}'")
+  endif()
+  set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS_PRIVATE_DIRS
+      ${CMAKE_SYSROOT}/lib/${CMAKE_LIBRARY_ARCHITECTURE} ${CMAKE_SYSROOT}/usr/lib/${CMAKE_LIBRARY_ARCHITECTURE})
+  set(FUSEDET_DEB_HOST_ARCH ${CPACK_DEBIAN_PACKAGE_ARCHITECTURE})
+  configure_file(cmake/deb/cross.cmake.in ${PROJECT_BINARY_DIR}/deb/cross.cmake @ONLY)
+  set(CPACK_PROJECT_CONFIG_FILE ${PROJECT_BINARY_DIR}/deb/cross.cmake)
+endif()
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "systemd | systemd-standalone-sysusers | systemd-sysusers, init-system-helpers (>= 1.54~)")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${PROJECT_SOURCE_DIR}/cmake/deb/postinst ${PROJECT_SOURCE_DIR}/cmake/deb/prerm

@@ -5,15 +5,20 @@
 # as the one conffile, dependencies computed by dpkg-shlibdeps, Debian-style maintainer scripts,
 # units that point at /usr/bin and /etc, a packaged config the packaged fusedetd accepts, and
 # lintian without errors or warnings.
-# Usage: check_package.sh BUILD_DIR SOURCE_DIR
+# Usage: check_package.sh BUILD_DIR SOURCE_DIR [RUNNER...]
+#   RUNNER: what runs the packaged fusedetd, for a cross build's package (scripts/arm64-package:
+#   qemu-aarch64-static -L SYSROOT); FUSEDET_PACKAGE_OUT: a folder to keep the package in.
 set -euo pipefail
 build=$1 src=$2
+shift 2
+runner=("$@")
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "check_package: $*" >&2; exit 1; }
 
-(cd "$build" && cpack -G DEB -B "$tmp" >"$tmp/cpack.log" 2>&1) || { cat "$tmp/cpack.log" >&2; fail "cpack failed"; }
-debs=("$tmp"/fusedet_*.deb)
+out=$(mkdir -p "${FUSEDET_PACKAGE_OUT:-$tmp}" && cd "${FUSEDET_PACKAGE_OUT:-$tmp}" && pwd)
+(cd "$build" && cpack -G DEB -B "$out" >"$tmp/cpack.log" 2>&1) || { cat "$tmp/cpack.log" >&2; fail "cpack failed"; }
+debs=("$out"/fusedet_*.deb)
 [[ ${#debs[@]} -eq 1 && -f ${debs[0]} ]] || fail "expected one fusedet_*.deb, got: ${debs[*]}"
 deb=${debs[0]}
 echo "package: $(basename "$deb") ($(stat -c %s "$deb") bytes)"
@@ -69,7 +74,7 @@ grep -qx 'StateDirectory=fusedet-recordings' "$tmp/root/lib/systemd/system/fused
 group=$(awk '$1 == "g" {print $2}' "$tmp/root/usr/lib/sysusers.d/fusedet.conf")
 grep -qx "SocketGroup=$group" "$tmp/root/lib/systemd/system/fusedetd.socket" || fail "the socket's group is not the sysusers group '$group'"
 cmp -s "$tmp/root/etc/fusedet/fusedet.yaml" "$src/config/fusedet.yaml" || fail "packaged fusedet.yaml differs from config/fusedet.yaml"
-"$tmp/root/usr/bin/fusedetd" --config "$tmp/root/etc/fusedet/fusedet.yaml" --check-config >/dev/null ||
+"${runner[@]}" "$tmp/root/usr/bin/fusedetd" --config "$tmp/root/etc/fusedet/fusedet.yaml" --check-config >/dev/null ||
   fail "the packaged fusedetd rejects the packaged config"
 for m in car bike person; do
   cmp -s "$tmp/root/usr/share/fusedet/models/$m.json" "$src/models/$m.json" || fail "model $m differs from models/$m.json"
