@@ -39,12 +39,17 @@ void* operator new[](std::size_t n) {
 }
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return recordedAlloc(n); }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return recordedAlloc(n); }
+// GCC at -O1 inlines these into gtest's `delete` and warns that free() meets operator new's
+// pointer; here operator new is ours and returns malloc's memory, so the pair matches.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
 
 namespace fs = std::filesystem;
 using namespace fusedet::drivers::mcap;
