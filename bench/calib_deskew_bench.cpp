@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "calib_starts.h"
+#include "fusedet/core/percentile.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
 #include "fusedet/fusion/calibration/score_profile.h"
 #include "fusedet/fusion/calibration/sweep_motion.h"
@@ -29,6 +30,7 @@
 namespace {
 
 using namespace fusedet::fusion;
+using fusedet::percentile;
 namespace fs = std::filesystem;
 
 constexpr double kFramePeriod = 0.1;  // [s] KITTI records at 10 Hz; the Velodyne turns once per frame
@@ -45,12 +47,6 @@ Eigen::Matrix<double, 6, 1> edgePeaks(const CalibFrame& frame, const Eigen::Matr
   Eigen::Matrix<double, 6, 1> peak;
   for (int a = 0; a < 6; ++a) peak(a) = p.peakOffset(a, false) * (a < 3 ? 1.0 : 100.0);
   return peak;
-}
-
-double percentile(std::vector<double> v, double q) {
-  std::sort(v.begin(), v.end());
-  const std::size_t rank = static_cast<std::size_t>(std::ceil(q / 100.0 * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
 }  // namespace
@@ -189,14 +185,14 @@ int main(int argc, char** argv) {
     const char* names[6] = {"rx", "ry", "rz", "tx", "ty", "tz"};
     std::printf("\naxis  |error| p50 / p90, recorded -> de-skewed (deg or cm)\n");
     for (int a = 0; a < 6; ++a)
-      std::printf("%-4s  %6.3f / %6.3f -> %6.3f / %6.3f\n", names[a], percentile(err[0][a], 50), percentile(err[0][a], 90),
-                  percentile(err[1][a], 50), percentile(err[1][a], 90));
+      std::printf("%-4s  %6.3f / %6.3f -> %6.3f / %6.3f\n", names[a], percentile(err[0][a], 0.50), percentile(err[0][a], 0.90),
+                  percentile(err[1][a], 0.50), percentile(err[1][a], 0.90));
     std::printf("within %.2f deg / %.3f m: recorded %d of %d, de-skewed %d of %d\n", limitDeg, limitT, within[0], trials, within[1], trials);
     std::printf("bench: calib_deskew_trials %d\n", trials);
     std::printf("bench: calib_deskew_recorded_within %d\n", within[0]);
     std::printf("bench: calib_deskew_deskewed_within %d\n", within[1]);
-    std::printf("bench: calib_deskew_recorded_tx_p50_cm %.2f\n", percentile(err[0][3], 50));
-    std::printf("bench: calib_deskew_deskewed_tx_p50_cm %.2f\n", percentile(err[1][3], 50));
+    std::printf("bench: calib_deskew_recorded_tx_p50_cm %.2f\n", percentile(err[0][3], 0.50));
+    std::printf("bench: calib_deskew_deskewed_tx_p50_cm %.2f\n", percentile(err[1][3], 0.50));
   }
   return 0;
 }

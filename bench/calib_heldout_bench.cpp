@@ -23,6 +23,7 @@
 
 #include "calib_starts.h"
 #include "fusedet/core/cpu_time.h"
+#include "fusedet/core/percentile.h"
 #include "fusedet/fusion/calibration/calib_kitti.h"
 #include "fusedet/fusion/calibration/calib_targetless.h"
 #include "fusedet/fusion/datasets/kitti_drives.h"
@@ -30,15 +31,8 @@
 namespace {
 
 using namespace fusedet::fusion;
+using fusedet::percentile;
 namespace fs = std::filesystem;
-
-// The p-th percentile (0-100) by nearest rank.
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return std::nan("");
-  std::sort(v.begin(), v.end());
-  const std::size_t rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(v.size())));
-  return v[std::min(v.size() - 1, rank == 0 ? 0 : rank - 1)];
-}
 
 // Raw drive of a calibration frame named "<dir name>/<id>".
 std::string driveOfFrame(const std::string& name, const std::map<std::string, KittiDriveMap>& maps) {
@@ -166,8 +160,8 @@ int main(int argc, char** argv) {
     const double k = a < 3 ? 1.0 : 100.0;
     double cover = 0;
     for (double c : covered[a]) cover += c;
-    std::printf("%-4s  %10.3f %6.3f %6.3f %6.3f   %13s   %s\n", calibAxisName(a), k * percentile(err[a], 50),
-                k * percentile(err[a], 90), k * percentile(err[a], 95), k * percentile(err[a], 100), "",
+    std::printf("%-4s  %10.3f %6.3f %6.3f %6.3f   %13s   %s\n", calibAxisName(a), k * percentile(err[a], 0.50),
+                k * percentile(err[a], 0.90), k * percentile(err[a], 0.95), k * percentile(err[a], 1.0), "",
                 covered[a].empty() ? "held" : (std::to_string(static_cast<int>(std::lround(100 * cover / static_cast<double>(covered[a].size())))) + " %").c_str());
   }
   std::printf("\n%d of %d trials within %.2f deg / %.3f m; outside: %d flagged, %d held, %d silent (%d of them wrong by "

@@ -24,6 +24,7 @@
 #include <thread>
 
 #include "fusedet/boost/vector_path.h"
+#include "fusedet/core/percentile.h"
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/service_parts.h"

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/stats.h"
 
+#include "fusedet/core/percentile.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -52,14 +54,6 @@ LatencySummary LatencyRecorder::summary() const {
   s.p99Ms = percentile(v, 0.99);
   s.maxMs = *std::max_element(v.begin(), v.end());
   return s;
-}
-
-double percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0;
-  std::sort(values.begin(), values.end());
-  const double rank = std::ceil(q * static_cast<double>(values.size()));
-  const auto i = static_cast<std::size_t>(std::clamp(rank, 1.0, static_cast<double>(values.size()))) - 1;
-  return values[i];
 }
 
 }  // namespace fusedet::daemon

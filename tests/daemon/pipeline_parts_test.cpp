@@ -63,12 +63,7 @@ TEST(BoundedQueue, ABytesBudgetBoundsItToo) {
   EXPECT_EQ(small.counters().bytes, 30u);
 }
 
-TEST(Stats, PercentilesAndRates) {
-  std::vector<double> v;
-  for (int i = 100; i >= 1; --i) v.push_back(i);
-  EXPECT_DOUBLE_EQ(percentile(v, 0.5), 50);
-  EXPECT_DOUBLE_EQ(percentile(v, 0.99), 99);
-  EXPECT_DOUBLE_EQ(percentile(v, 1.0), 100);
+TEST(Stats, LatencySummaryAndRates) {
   LatencyRecorder r(10);
   for (int i = 1; i <= 20; ++i) r.add(i);  // keeps 11..20
   EXPECT_EQ(r.summary().samples, 10u);

@@ -15,6 +15,7 @@
 #include <random>
 #include <sstream>
 
+#include "fusedet/core/percentile.h"
 #include "fusedet/daemon/config.h"
 #include "fusedet/daemon/rig.h"
 #include "fusedet/drivers/log/log_info.h"
@@ -113,13 +114,6 @@ Replayed replayAndFuse(const fs::path& log) {
   out.counters = replay.counters();
   out.sweepStats = sweeps.stats();
   return out;
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const auto k = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + static_cast<long>(k), v.end());
-  return v[k];
 }
 
 SynthOptions kittiOptions() {

@@ -45,7 +45,4 @@ class LatencyRecorder {
   std::size_t next_ = 0;
 };
 
-// Nearest-rank percentile (q in [0, 1]) of unsorted values; 0 for none.
-double percentile(std::vector<double> values, double q);
-
 }  // namespace fusedet::daemon
