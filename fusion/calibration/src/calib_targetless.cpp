@@ -258,9 +258,14 @@ TargetlessResult calibrateTargetless(const std::vector<CalibFrame>& frames, cons
   // (bench_calib_heldout --half choose) it covered the real error in 27-60 % of trials per axis,
   // twice it in 44-78 % (a 1-sigma should cover about 68 %). docs/results "Calibration": the held-out check.
   constexpr double kJackknifeScale = 2.0;
+  // A bias no leave-one-out run can see (the frames all pull the same way) is added in quadrature:
+  // per axis the smallest term that lifts coverage on those choose trials to 68 % (seed 35, 30
+  // trials: rz 63 -> 70 %, tx 53 -> 70 %; the other axes already covered 73-80 %).
+  const Eigen::Vector3d kSystematicDeg(0, 0, 0.04);
+  const Eigen::Vector3d kSystematic(0.016, 0, 0);  // [m]
   const detail::PoseSpread spread = detail::jackknifeSpread(loo, current);
-  result.rotationStdDeg = kJackknifeScale * spread.rotationStdDeg;
-  result.translationStd = kJackknifeScale * spread.translationStd;
+  result.rotationStdDeg = ((kJackknifeScale * spread.rotationStdDeg).array().square() + kSystematicDeg.array().square()).sqrt();
+  result.translationStd = ((kJackknifeScale * spread.translationStd).array().square() + kSystematic.array().square()).sqrt();
   for (int a = 0; a < 3; ++a) {  // a held axis is where the user put it: no spread of its own
     if (options.hold[static_cast<std::size_t>(a)]) result.rotationStdDeg(a) = 0;
     if (options.hold[static_cast<std::size_t>(a + 3)]) result.translationStd(a) = 0;
