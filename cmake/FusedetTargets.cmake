@@ -5,7 +5,10 @@
 function(fusedet_warnings target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
                                            -Wcast-align -Wnull-dereference -Wformat=2)
-  if(FUSEDET_WERROR)
+  # Not in sanitizer builds: GCC's flow-sensitive warnings (null-dereference, mismatched-new-delete,
+  # maybe-uninitialized) change with the instrumentation and -O1 and were false there, in libstdc++,
+  # CLI11 and our tests alike (docs/reliability.md); the plain build keeps every warning an error.
+  if(FUSEDET_WERROR AND NOT FUSEDET_SANITIZE)
     target_compile_options(${target} PRIVATE -Werror)
   endif()
 endfunction()

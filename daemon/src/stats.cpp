@@ -1,10 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "fusedet/daemon/stats.h"
 
-#include "fusedet/core/percentile.h"
-
 #include <algorithm>
-#include <cmath>
+
+#include "fusedet/core/percentile.h"
 
 namespace fusedet::daemon {
 
