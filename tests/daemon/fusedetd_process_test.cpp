@@ -253,6 +253,15 @@ TEST(Fusedetd, NotifyWatchdogReloadAndSigterm) {
   EXPECT_NE(failed["last_reload_error"].get<std::string>().find("unknown key detection.modles"), std::string::npos)
       << failed.dump();
   EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
+  // A YAML complex key (yaml-cpp's conversion error once escaped the reload and ended the
+  // process): refused the same way, the daemon goes on.
+  { std::ofstream(config) << "? [a]: 1\n"; }
+  notify.clear();
+  ::kill(daemon.pid(), SIGHUP);
+  ASSERT_TRUE(notify.waitFor("reload failed", 10s)) << readFile(dir / "log");
+  EXPECT_NE(ask(client, "status")["last_reload_error"].get<std::string>().find("a key must be a plain name, not a mapping"),
+            std::string::npos);
+  EXPECT_EQ(ask(client, "hello")["classes"], nlohmann::json({"car", "bike", "person"}));
   // A good one applies, the same connections stay and the subscriber keeps receiving.
   writeReplayConfig(config, socket, {"bike"});
   ::kill(daemon.pid(), SIGHUP);
