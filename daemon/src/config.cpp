@@ -10,6 +10,7 @@
 #include "fusedet/drivers/usb/usb_match.h"
 #include "fusedet/drivers/v4l2/controls.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -409,19 +410,43 @@ std::filesystem::path installedConfigFile(const std::filesystem::path& executabl
   return etc / "fusedet" / "fusedet.yaml";
 }
 
+namespace {
+
+// yaml-cpp's emitter writes a string holding control characters (a run of carriage returns, say)
+// as a plain scalar, which does not read back the same: such strings are written double-quoted
+// (escaped), every other value as the emitter chooses. Found by fuzzing (tests/fuzz/config_yaml).
+struct Text {
+  const std::string& value;
+};
+Text text(const std::string& value) { return {value}; }
+template <class T>
+const T& text(const T& value) {
+  return value;
+}
+YAML::Emitter& operator<<(YAML::Emitter& out, Text t) {
+  const bool control = std::any_of(t.value.begin(), t.value.end(), [](char ch) {
+    const auto u = static_cast<unsigned char>(ch);
+    return u < 0x20 || u == 0x7f;
+  });
+  if (control) out << YAML::DoubleQuoted;
+  return out << t.value;
+}
+
+}  // namespace
+
 std::string dumpConfig(const Config& c) {
   YAML::Emitter out;
   auto seq = [&out](const auto& values) {
     out << YAML::Flow << YAML::BeginSeq;
-    for (const auto& v : values) out << v;
+    for (const auto& v : values) out << text(v);
     out << YAML::EndSeq;
   };
   out << YAML::BeginMap;
   out << YAML::Key << "version" << YAML::Value << c.version;
   out << YAML::Key << "log" << YAML::Value << YAML::BeginMap << YAML::Key << "level" << YAML::Value
-      << c.logLevel << YAML::EndMap;
+      << text(c.logLevel) << YAML::EndMap;
   out << YAML::Key << "socket" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "path" << YAML::Value << c.socket.path;
+  out << YAML::Key << "path" << YAML::Value << text(c.socket.path);
   out << YAML::Key << "max_clients" << YAML::Value << c.socket.maxClients;
   out << YAML::Key << "max_request_bytes" << YAML::Value << c.socket.maxRequestBytes;
   out << YAML::Key << "client_queue" << YAML::Value << c.socket.clientQueue;
@@ -432,16 +457,16 @@ std::string dumpConfig(const Config& c) {
   seq(c.socket.allowGroups);
   out << YAML::EndMap;
   out << YAML::Key << "laser" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "device" << YAML::Value << c.laser.device;
+  out << YAML::Key << "device" << YAML::Value << text(c.laser.device);
   out << YAML::Key << "baud" << YAML::Value << c.laser.baud;
   out << YAML::Key << "angle_deg" << YAML::Value << c.laser.angleDeg;
   out << YAML::Key << "resolution_deg" << YAML::Value << c.laser.resolutionDeg;
   out << YAML::Key << "remission" << YAML::Value << c.laser.remission;
-  out << YAML::Key << "range_unit" << YAML::Value << c.laser.rangeUnit;
+  out << YAML::Key << "range_unit" << YAML::Value << text(c.laser.rangeUnit);
   out << YAML::Key << "remission_full_scale" << YAML::Value << c.laser.remissionFullScale;
   out << YAML::Key << "reconnect_max_s" << YAML::Value << c.laser.reconnectMaxS << YAML::EndMap;
   out << YAML::Key << "tilt" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "interface" << YAML::Value << c.tilt.interface;
+  out << YAML::Key << "interface" << YAML::Value << text(c.tilt.interface);
   out << YAML::Key << "node_id" << YAML::Value << c.tilt.nodeId;
   out << YAML::Key << "min_deg" << YAML::Value << c.tilt.minDeg;
   out << YAML::Key << "max_deg" << YAML::Value << c.tilt.maxDeg;
@@ -451,18 +476,18 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "zero_offset_counts" << YAML::Value << c.tilt.zeroOffsetCounts;
   out << YAML::Key << "heartbeat_ms" << YAML::Value << c.tilt.heartbeatMs << YAML::EndMap;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "device" << YAML::Value << c.camera.device;
-  out << YAML::Key << "usb" << YAML::Value << c.camera.usb;
-  out << YAML::Key << "format" << YAML::Value << c.camera.format;
+  out << YAML::Key << "device" << YAML::Value << text(c.camera.device);
+  out << YAML::Key << "usb" << YAML::Value << text(c.camera.usb);
+  out << YAML::Key << "format" << YAML::Value << text(c.camera.format);
   out << YAML::Key << "width" << YAML::Value << c.camera.width;
   out << YAML::Key << "height" << YAML::Value << c.camera.height;
   out << YAML::Key << "fps" << YAML::Value << c.camera.fps;
   out << YAML::Key << "buffers" << YAML::Value << c.camera.buffers;
-  out << YAML::Key << "exposure" << YAML::Value << c.camera.exposure;
-  out << YAML::Key << "gain" << YAML::Value << c.camera.gain;
+  out << YAML::Key << "exposure" << YAML::Value << text(c.camera.exposure);
+  out << YAML::Key << "gain" << YAML::Value << text(c.camera.gain);
   out << YAML::Key << "stall_ms" << YAML::Value << c.camera.stallMs;
   out << YAML::Key << "reconnect_max_s" << YAML::Value << c.camera.reconnectMaxS;
-  out << YAML::Key << "calibration" << YAML::Value << c.camera.calibration << YAML::EndMap;
+  out << YAML::Key << "calibration" << YAML::Value << text(c.camera.calibration) << YAML::EndMap;
   out << YAML::Key << "fusion" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "laser_to_camera" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "rotation_rpy_deg" << YAML::Value;
@@ -479,11 +504,11 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "close_on_tilt" << YAML::Value << c.fusion.closeOnTilt << YAML::EndMap;
   out << YAML::Key << "neural" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "enabled" << YAML::Value << c.neural.enabled;
-  out << YAML::Key << "kind" << YAML::Value << c.neural.kind;
+  out << YAML::Key << "kind" << YAML::Value << text(c.neural.kind);
   out << YAML::Key << "files" << YAML::Value;
   seq(c.neural.files);
-  out << YAML::Key << "directory" << YAML::Value << c.neural.directory;
-  out << YAML::Key << "input" << YAML::Value << c.neural.input;
+  out << YAML::Key << "directory" << YAML::Value << text(c.neural.directory);
+  out << YAML::Key << "input" << YAML::Value << text(c.neural.input);
   out << YAML::Key << "scale" << YAML::Value << c.neural.scale;
   out << YAML::Key << "threads" << YAML::Value << c.neural.threads << YAML::EndMap;
   out << YAML::Key << "detection" << YAML::Value << YAML::BeginMap;
@@ -500,7 +525,7 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "threads" << YAML::Value << c.detection.threads;
   out << YAML::Key << "classes" << YAML::Value << YAML::BeginMap;
   for (const auto& k : c.detection.classes)
-    out << YAML::Key << k.name << YAML::Value << YAML::BeginMap << YAML::Key << "min_neighbors" << YAML::Value
+    out << YAML::Key << text(k.name) << YAML::Value << YAML::BeginMap << YAML::Key << "min_neighbors" << YAML::Value
         << k.minNeighbors << YAML::Key << "laser_extent" << YAML::Value << k.laserExtent << YAML::EndMap;
   out << YAML::EndMap << YAML::EndMap;
   out << YAML::Key << "tracking" << YAML::Value << YAML::BeginMap;
@@ -519,11 +544,11 @@ std::string dumpConfig(const Config& c) {
   out << YAML::Key << "max_viewers" << YAML::Value << c.live.maxViewers;
   out << YAML::Key << "viewer_queue_bytes" << YAML::Value << c.live.viewerQueueBytes << YAML::EndMap;
   out << YAML::Key << "replay" << YAML::Value << YAML::BeginMap;
-  out << YAML::Key << "file" << YAML::Value << c.replay.file;
+  out << YAML::Key << "file" << YAML::Value << text(c.replay.file);
   out << YAML::Key << "realtime" << YAML::Value << c.replay.realtime;
   out << YAML::Key << "speed" << YAML::Value << c.replay.speed;
   out << YAML::Key << "restamp" << YAML::Value << c.replay.restamp;
-  out << YAML::Key << "at_end" << YAML::Value << c.replay.atEnd << YAML::EndMap;
+  out << YAML::Key << "at_end" << YAML::Value << text(c.replay.atEnd) << YAML::EndMap;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

@@ -178,3 +178,15 @@ TEST(Config, TrackingKeysRoundTripAndAreChecked) {
   EXPECT_EQ(errorOf("tracking:\n  gates: 3\n"), "test.yaml:2: unknown key tracking.gates");
   EXPECT_EQ(errorOf("tracking:\n  gate: -1\n"), "test.yaml:2: key tracking.gate: -1 is outside [0.001, 1e+06]");
 }
+
+// Found by fuzzing: a value ending in carriage returns was dumped as a plain scalar and read back
+// one shorter (the reload's merge and --dump-config go through the dump).
+TEST(Config, ADumpedStringWithControlCharactersReadsBackTheSame) {
+  const Config c = parseConfig("replay:\n  file: \"log.mcap\\r\\r\"\nlaser:\n  device: \"/dev/tty\\tUSB0\"\n", "t.yaml");
+  EXPECT_EQ(c.replay.file, "log.mcap\r\r");
+  EXPECT_EQ(c.laser.device, "/dev/tty\tUSB0");
+  const Config back = parseConfig(dumpConfig(c), "dump.yaml");
+  EXPECT_EQ(back.replay.file, c.replay.file);
+  EXPECT_EQ(back.laser.device, c.laser.device);
+  EXPECT_EQ(dumpConfig(back), dumpConfig(c));
+}
