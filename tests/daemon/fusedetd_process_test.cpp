@@ -432,12 +432,14 @@ void writeSlowModel(const fs::path& file) {
       << R"( "layers": ["intensity"], "reference_hue": null, "stages": [)";
   // 20 stages of 400 stumps that every window passes: seconds per stack even on the fastest vector
   // path (5 stages took under 2 s once gathers were gone, and the stack ended before the checks).
+  // Each leaf -1 and the threshold -400, the stage's least sum: every window ties it, so no stump
+  // before the last decides the stage (the vector scanners stop a stage once it is decided).
   for (int s = 0; s < 20; ++s) {
-    out << R"({"threshold": -1e9, "stumps": [)";
+    out << R"({"threshold": -400, "stumps": [)";
     for (int k = 0; k < 400; ++k) {
       const int i = s * 400 + k;
       out << (k ? "," : "") << R"({"type": "b", "rect": [)" << (i % 20) / 25.0 << ", " << ((i / 20) % 20) / 25.0 << ", "
-          << 0.1 + 0.005 * (i / 400) << R"(, 0.2], "layer": "intensity", "threshold": 0, "left": 1, "right": 1})";
+          << 0.1 + 0.005 * (i / 400) << R"(, 0.2], "layer": "intensity", "threshold": 0, "left": -1, "right": -1})";
     }
     out << "]},";
   }

@@ -63,6 +63,10 @@ struct GridStump {
   double invBlackArea = 1, invWhiteArea = 1, quickBelow = 0, quickAbove = 0;
   float threshold = 0;
   double left = 0, right = 0;
+  // The vector paths' early stage decision (setEarlyBounds()): after this stump, a stage sum below
+  // rejectBelow fails the stage whatever the stumps still to come add, one above acceptAbove passes it.
+  double rejectBelow = -std::numeric_limits<double>::infinity();
+  double acceptAbove = std::numeric_limits<double>::infinity();
 };
 
 // The margin m of one stump (see GridStump) whose layer's values lie within +-bound (its slot's
@@ -93,6 +97,26 @@ void setQuickBounds(GridStump& z, const IntegralGrid& gr, int slot, const Featur
   }
   z.quickBelow = cut - m;
   z.quickAbove = cut + m;
+}
+
+// Sets rejectBelow and acceptAbove of the stumps [begin, end) of one stage (threshold t): after stump
+// k the sum still gains between lo_k and hi_k, the sums of min(left, right) and max(left, right) of
+// the stumps behind k. A sum s_k < t - hi_k - m ends below t, s_k > t - lo_k + m at or above it,
+// where m covers the rounding: every partial sum lies within A = sum of max(|left|, |right|), each of
+// the n additions still to come and of the bounds' own is off by at most u * (|t| + A) (u = 2^-53),
+// and m = 4 (n + 2) u (|t| + A) is twice that. The last stage accepts nothing early (its sum is the
+// window's score), and the last stump decides nothing (its stage sum is complete).
+void setEarlyBounds(std::vector<GridStump>& stumps, std::size_t begin, std::size_t end, double t, bool lastStage) {
+  double A = 0;
+  for (std::size_t k = begin; k < end; ++k) A += std::max(std::fabs(stumps[k].left), std::fabs(stumps[k].right));
+  const double m = 4.0 * double(end - begin + 2) * 0x1p-53 * (std::fabs(t) + A);
+  double lo = 0, hi = 0;
+  for (std::size_t k = end - 1; k-- > begin;) {
+    lo += std::min(stumps[k + 1].left, stumps[k + 1].right);
+    hi += std::max(stumps[k + 1].left, stumps[k + 1].right);
+    stumps[k].rejectBelow = t - hi - m;
+    if (!lastStage) stumps[k].acceptAbove = t - lo + m;
+  }
 }
 
 std::atomic<bool> gQuickDecisions{true};
@@ -192,6 +216,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       sp.stumps.push_back(z);
     }
     gs.end = static_cast<std::uint32_t>(sp.stumps.size());
+    if (gs.end > gs.begin) setEarlyBounds(sp.stumps, gs.begin, gs.end, st.threshold, &st == &c.stages.back());
     for (std::uint32_t k = gs.begin; k < gs.end; ++k) gs.grids |= 1u << sp.stumps[k].grid;
     sp.stages.push_back(gs);
   }
@@ -273,6 +298,7 @@ std::size_t stageScalar(const GridScale& sp, const GridStage& st, const void* co
 
 #ifdef FUSEDET_HAVE_VECTOR_GRID_PATH
 constexpr std::size_t kMaxVectorGrids = 8;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // How a vector path loads the corners of one step's windows in one grid (GridScale::colStride):
 // lane by lane, or from the first window's origin for origins 1, 2, 3 or more values apart, or in

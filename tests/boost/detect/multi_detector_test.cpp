@@ -140,6 +140,50 @@ TEST(MultiDetector, ScalarFormEqualsVectorForms) {
   }
 }
 
+// The vector forms decide a stage before its last stump once no stump to come can change it
+// (window_scanner.cpp, setEarlyBounds()). Leaves of +-j for the j-th stump of a stage (exact sums,
+// each stump its own weight) and stage thresholds on sums the windows reach make many stage sums
+// land exactly on the threshold or one stump away from deciding it: still every hit and score as
+// the scalar form, which adds every stump.
+TEST(MultiDetector, ScalarFormEqualsVectorFormsWhereStageSumsTieTheThreshold) {
+  std::vector<Cascade> models = bundledModels();
+  for (Cascade& c : models)
+    for (Stage& st : c.stages) {
+      double leaves = 0, weights = 0;
+      for (std::size_t j = 0; j < st.stumps.size(); ++j) {
+        Stump& t = st.stumps[j];
+        leaves += std::abs(t.left) + std::abs(t.right);
+        const double w = double(j + 1), side = t.left < t.right ? -w : w;
+        weights += 2 * w;
+        t.left = side;
+        t.right = -side;
+      }
+      // Every sum of +-1, +-2, ..., +-n has the parity of 1 + 2 + ... + n: the threshold takes it,
+      // near the model's own.
+      const double n = double(st.stumps.size()), t = std::round(st.threshold * weights / leaves);
+      st.threshold = std::fmod(std::abs(t - n * (n + 1) / 2), 2.0) == 0 ? t : t + 1;
+    }
+  const MultiDetector all(models);
+  ScanParams p;
+  p.threads = 1;
+  const LayerStack& s = kittiStacks().front();
+  std::vector<ScanStats> a;
+  setVectorScanEnabled(false);
+  const auto scalar = all.scan(s, p, &a);
+  setVectorScanEnabled(true);
+  std::size_t hits = 0;
+  for (int lanes : {8, 4}) {
+    setVectorLanesLimit(lanes);
+    const auto vec = all.scan(s, p);
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      expectSameHits(vec[i], scalar[i], all.cascade(i).className + " " + std::to_string(lanes) + " lanes");
+      hits += scalar[i].size();
+    }
+  }
+  setVectorLanesLimit(8);
+  EXPECT_GT(hits, 0u) << "thresholds on reachable sums should let some windows through";
+}
+
 // Layers whose values are NaN, infinite or huge in places: the vector forms' quick decisions (bounded
 // by each layer's largest magnitude, IntegralGrids::bounds) and their exact fallback still decide
 // as the scalar form, window for window.

@@ -50,7 +50,7 @@ struct RawHit {
 
 struct ScanStats {
   std::size_t windows = 0;   // windows evaluated
-  std::size_t stumps = 0;    // weak classifiers evaluated
+  std::size_t stumps = 0;    // weak classifiers of the stages the windows reached (the vector scanners may decide a stage before its last)
   std::size_t scales = 0;
 };
 
