@@ -11,6 +11,8 @@
 #include <cstring>
 #include <stdexcept>
 
+#include <sys/mman.h>
+
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
@@ -156,6 +158,17 @@ double integrateSource(const Source& s, double* slot0, std::ptrdiff_t pitch) {
 thread_local std::vector<std::vector<double>> tBuffers;
 thread_local std::vector<std::vector<std::int32_t>> tIntBuffers;
 
+// Asks the kernel for transparent huge pages (2 MiB) over the whole 2 MiB pages of [p, p + bytes):
+// the scanners read tables of tens of MB at scattered rows, and with 4 KiB pages nearly every
+// corner of a later stage is another page (TLB misses; measured: bench/README.md). Where the kernel
+// gives none (THP "never", another page size), nothing changes.
+void adviseHugePages(const void* p, std::size_t bytes) {
+  constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
+  const auto start = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t from = (start + kHuge - 1) & ~(kHuge - 1), to = (start + bytes) & ~(kHuge - 1);
+  if (to > from) (void)madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);
+}
+
 // The pooled buffer of n values if there is one (the next stack has the same sizes), else the
 // last: a buffer of another grid's size would be grown by resize(), which zeroes what it adds -
 // megabytes per stack when a camera-size grid took the laser grid's buffer.
@@ -167,6 +180,11 @@ std::vector<T> takeBuffer(std::vector<std::vector<T>>& pool, std::size_t n) {
     if (it == pool.end()) it = pool.end() - 1;
     b = std::move(*it);
     pool.erase(it);
+  }
+  if (b.capacity() < n) {  // a new buffer: huge pages asked for before its first touch
+    b = std::vector<T>();
+    b.reserve(n);
+    adviseHugePages(b.data(), n * sizeof(T));
   }
   b.resize(n);
   return b;
