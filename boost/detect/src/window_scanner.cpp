@@ -709,6 +709,7 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   // other, so the integral rows one brings into the cache serve the next.
   struct Item {
     std::size_t cascade, scale, x0, x1, y0, y1;
+    std::tuple<std::size_t, int, int, std::size_t> place;  // (scale, top, left, cascade): unique
   };
   std::vector<Item> items;
   for (std::size_t c = 0; c < nc; ++c)
@@ -718,14 +719,10 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
         const std::size_t x1 = std::min(w.xs.size(), x0 + kBand);
         const std::size_t rows = std::max<std::size_t>(1, kTileWindows / (x1 - x0));
         for (std::size_t y0 = 0; y0 < w.ys.size(); y0 += rows)
-          items.push_back(Item{c, s, x0, x1, y0, std::min(w.ys.size(), y0 + rows)});
+          items.push_back(Item{c, s, x0, x1, y0, std::min(w.ys.size(), y0 + rows), {s, w.ys[y0], w.xs[x0], c}});
       }
     }
-  auto place = [&](const Item& it) {
-    const ScaleWindows& w = plans[it.cascade][it.scale].win;
-    return std::make_tuple(it.scale, w.ys[it.y0], w.xs[it.x0], it.cascade);
-  };
-  std::stable_sort(items.begin(), items.end(), [&](const Item& a, const Item& b) { return place(a) < place(b); });
+  std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.place < b.place; });
   std::vector<const void*> grids(ng);
   for (std::size_t g = 0; g < ng; ++g) grids[g] = in.grids()[g].base();
   std::vector<std::vector<RawHit>> hits(items.size());
