@@ -167,9 +167,8 @@ TEST(MultiDetector, ScalarFormEqualsVectorFormsWhereStageSumsTieTheThreshold) {
   ScanParams p;
   p.threads = 1;
   const LayerStack& s = kittiStacks().front();
-  std::vector<ScanStats> a;
   setVectorScanEnabled(false);
-  const auto scalar = all.scan(s, p, &a);
+  const auto scalar = all.scan(s, p);
   setVectorScanEnabled(true);
   std::size_t hits = 0;
   for (int lanes : {8, 4}) {
