@@ -12,6 +12,28 @@
 namespace fusedet::daemon {
 namespace {
 constexpr std::chrono::milliseconds kIdleWake{200};  // threads show liveness at least this often
+}  // namespace
+
+// The first stack through a thread used to pay for what later ones reuse: fresh buffers (page
+// faults, zeroed pages). Measured in bench_daemon_latency (bench/README.md): the first stack's
+// integral tables 17 ms against 3 ms, its detection 78-85 ms against 38-57 ms, its fusion 12-17 ms
+// against 7-9 ms - the p99 of a short run was that one stack. So the fusion thread fuses a blank
+// stack (a black image, an empty sweep) of the rig's sizes before its first real one, and the
+// detection thread readies the detector on one (StackDetector::prepare: the tables, no model
+// runs); nothing of it is counted, queued or delivered, and a failure only costs the warm-up.
+void Pipeline::warmUp(WarmUp stage) {
+  const char* name = stage == WarmUp::kFusion ? "fusion" : "detection";
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto& p = setup_.fuser->projection();
+    cv::Mat undistorted;
+    const LayerStack blank = setup_.fuser->fuseSensors(cv::Mat::zeros(p.height, p.width, CV_8UC3), fusion::Sweep{}, &undistorted);
+    if (stage == WarmUp::kDetection) detector()->prepare(blank);
+    spdlog::debug("{} warm-up on a blank {}x{} stack: {:.1f} ms", name, p.width, p.height,
+                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  } catch (const std::exception& e) {
+    spdlog::warn("{} warm-up on a blank stack: {} (its first stack runs cold)", name, e.what());
+  }
 }
 
 Pipeline::Pipeline(PipelineSetup setup, std::shared_ptr<const StackDetector> detector, ResultHandler onResult)
@@ -120,6 +142,7 @@ bool Pipeline::idle() const {
 
 void Pipeline::fusionLoop() {
   nameThisThread("fd-fusion");
+  warmUp(WarmUp::kFusion);
   while (!abandon_) {
     fusionBeat_ = Stamp::now().ns;
     auto message = sensorQueue_.pop(kIdleWake);
@@ -263,6 +286,7 @@ void Pipeline::detectionLoop() {
   // Made here: TBB observes the arena of the thread that creates the observer, and the scan's
   // helpers work in this thread's arena.
   const TbbWorkerNames helpers("fd-tbb");
+  warmUp(WarmUp::kDetection);
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
   const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;
   while (!abandon_) {

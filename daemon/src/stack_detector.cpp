@@ -121,6 +121,8 @@ std::vector<Detection> CascadeSet::detectWithoutNetwork(const LayerStack& stack)
   return boosting::detectPerClass(*withoutNetwork_, stack, scan_, group_, extent_, perClass_);
 }
 
+void CascadeSet::prepare(const LayerStack& stack) const { detector_->prepare(stack, scan_); }
+
 std::vector<std::string> CascadeSet::networkClasses() const {
   std::vector<std::string> names;
   for (std::size_t i = 0; i < detector_->size(); ++i)

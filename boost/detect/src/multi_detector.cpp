@@ -42,6 +42,15 @@ std::vector<std::vector<RawHit>> MultiDetector::scan(const LayerStack& stack, co
   return out;
 }
 
+void MultiDetector::prepare(const LayerStack& stack, const ScanParams& params) const {
+  std::vector<LayerRequest> requests;
+  for (const Cascade& c : cascades_) {
+    if (c.isOpenCv() || (usesNetworkLayers(c.layers) && stack.network.empty())) continue;
+    for (LayerRequest& r : layerRequests(c)) requests.push_back(std::move(r));
+  }
+  if (!requests.empty()) (void)IntegralGrids(stack, requests, params.threads);
+}
+
 std::vector<Detection> detect(const MultiDetector& detector, const LayerStack& stack, const ScanParams& scan,
                               const GroupParams& group) {
   // Every class with the same grouping and no laser extent: detectPerClass() with no class of its own.

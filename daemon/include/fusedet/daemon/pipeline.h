@@ -214,6 +214,9 @@ class Pipeline : public SensorSink {
   void fusionLoop();
   void networkLoop();
   void detectionLoop();
+  // Readies one thread's stage on a blank stack before its first real one (pipeline.cpp says why).
+  enum class WarmUp { kFusion, kDetection };
+  void warmUp(WarmUp stage);
   // Pushes `fused` into `queue`; in lossless mode waits for room first, showing liveness in
   // `beat`. False when the pipeline stops meanwhile (the stack is dropped).
   bool handOver(BoundedQueue<FusedStack>& queue, FusedStack&& fused, std::atomic<std::int64_t>& beat);

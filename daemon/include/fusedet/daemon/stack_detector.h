@@ -32,6 +32,9 @@ class StackDetector {
   // Detections of every class not in networkClasses(), for a stack the network failed on (it
   // lacks the network's layers). Same boxes, scores and order as detect() gives those classes.
   virtual std::vector<Detection> detectWithoutNetwork(const LayerStack& stack) const { return detect(stack); }
+  // Readies the calling thread (and its helpers) for stacks of this one's sizes, e.g. buffers, so
+  // that the first real stack costs what later ones do. Called from the detecting thread.
+  virtual void prepare(const LayerStack& /*stack*/) const {}
 };
 
 // The config's detection section in the library's terms (one meaning for every key).
@@ -55,6 +58,7 @@ class CascadeSet : public StackDetector {
   std::vector<std::string> classes() const override;
   std::vector<std::string> networkClasses() const override;
   std::vector<Detection> detectWithoutNetwork(const LayerStack& stack) const override;
+  void prepare(const LayerStack& stack) const override;  // the tables (MultiDetector::prepare)
   const std::vector<std::filesystem::path>& files() const { return files_; }
   // detection.classes entries that name no loaded model (a typo, or a class not deployed): they
   // change nothing, so the constructor logs a warning naming them and the loaded classes.

@@ -39,6 +39,12 @@ class MultiDetector {
   std::vector<std::vector<RawHit>> scan(const LayerStack& stack, const ScanParams& params,
                                         std::vector<ScanStats>* stats = nullptr) const;
 
+  // Builds and drops the tables scan() builds for stacks of this one's sizes and layers, on
+  // params.threads threads: each thread then holds its table buffers (integral_grids.h keeps the
+  // last ones per thread), so the first real scan() does not pay for fresh memory (a service,
+  // before its first stack). Models whose network layers the stack lacks are left out.
+  void prepare(const LayerStack& stack, const ScanParams& params) const;
+
  private:
   std::vector<Cascade> cascades_;
 };
