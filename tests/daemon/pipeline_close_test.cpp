@@ -7,10 +7,9 @@
 
 #include <chrono>
 #include <cmath>
-#include <condition_variable>
-#include <mutex>
 
 #include "fusedet/daemon/pipeline.h"
+#include "pipeline_fixtures.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -45,29 +44,16 @@ class NoDetections : public StackDetector {
   std::vector<std::string> classes() const override { return {"none"}; }
 };
 
-struct Results {
-  std::mutex m;
-  std::condition_variable cv;
-  std::vector<StackResult> got;
-};
-
 // Feeds everything a device would have delivered up to (not including) `until`: tilt samples at
 // 100 Hz (5 ms phase) when stamped, scans 8 ms after their last beam (telegram), one camera frame
 // at the stroke's middle. Returns the pipeline's results after it went idle.
 std::vector<StackResult> feedUntil(bool closeOnTilt, std::int64_t until, PipelineCounters& counters) {
-  fusion::CameraModel camera;
-  camera.width = 64;
-  camera.height = 48;
-  camera.K << 50, 0, 32, 0, 50, 24, 0, 0, 1;
+  const fusion::CameraModel camera = fixtures::pinholeCamera(64, 48, 50);
   PipelineSetup setup;
   setup.fuser = std::make_shared<const fusion::Fuser>(camera, Eigen::Isometry3d::Identity());
   setup.sweep.closeOnTilt = closeOnTilt;
-  Results results;
-  Pipeline pipeline(setup, std::make_shared<NoDetections>(), [&](std::shared_ptr<const StackResult> r) {
-    std::lock_guard lock(results.m);
-    results.got.push_back(*r);
-    results.cv.notify_all();
-  });
+  fixtures::Results results;
+  Pipeline pipeline(setup, std::make_shared<NoDetections>(), results.handler());
   pipeline.start();
   drivers::CameraFrame frame;
   frame.stamp = Stamp{kT0 + kLastUp * kScanNs / 2};
@@ -98,8 +84,7 @@ std::vector<StackResult> feedUntil(bool closeOnTilt, std::int64_t until, Pipelin
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   counters = pipeline.counters();
   pipeline.stop(std::chrono::steady_clock::now() + std::chrono::seconds(2));
-  std::lock_guard lock(results.m);
-  return results.got;
+  return results.all();
 }
 }  // namespace
 

@@ -11,12 +11,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <thread>
 
 #include "fusedet/daemon/pipeline.h"
+#include "pipeline_fixtures.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -75,19 +75,12 @@ PairedScene sceneAt(double t, int width, int height) {
 }  // namespace
 
 TEST(PipelineVelocity, ATrackOfABoardMovingAtConstantVelocityHasThatVelocity) {
-  fusion::CameraModel camera;
-  camera.width = 320;
-  camera.height = 240;
-  camera.K << 300, 0, 160, 0, 300, 120, 0, 0, 1;
+  const fusion::CameraModel camera = fixtures::pinholeCamera(320, 240, 300);
   PipelineSetup setup;
   setup.fuser = std::make_shared<const fusion::Fuser>(camera, robotToCamera());
   setup.lossless = true;
-  std::mutex m;
-  std::vector<StackResult> got;
-  Pipeline pipeline(setup, std::make_shared<BoardDetector>(), [&](std::shared_ptr<const StackResult> r) {
-    std::lock_guard lock(m);
-    got.push_back(*r);
-  });
+  fixtures::Results results;
+  Pipeline pipeline(setup, std::make_shared<BoardDetector>(), results.handler());
   pipeline.start();
   // Irregular stack stamps [s]; the stack at 4.0 s is missing (dropped).
   const double stamps[] = {0.0, 1.0, 2.3, 3.0, 5.1, 6.0, 7.4, 8.0, 9.2, 10.0};
@@ -97,6 +90,7 @@ TEST(PipelineVelocity, ATrackOfABoardMovingAtConstantVelocityHasThatVelocity) {
     while (!pipeline.idle() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   pipeline.stop(std::chrono::steady_clock::now() + std::chrono::seconds(5));
+  const std::vector<StackResult> got = results.all();
   ASSERT_EQ(got.size(), std::size(stamps));
   for (std::size_t k = 0; k < got.size(); ++k) {
     const StackResult& r = got[k];

@@ -7,13 +7,13 @@
 #include <pthread.h>
 
 #include <chrono>
-#include <condition_variable>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "fusedet/daemon/pipeline.h"
+#include "pipeline_fixtures.h"
 
 using namespace fusedet;
 using namespace fusedet::daemon;
@@ -56,21 +56,12 @@ class RecordingDetector : public StackDetector {
 }  // namespace
 
 TEST(PipelineWarmUp, TheDetectorIsPreparedOnABlankStackOfTheRigBeforeTheFirstStackAndNothingOfItIsDelivered) {
-  fusion::CameraModel camera;
-  camera.width = 80;
-  camera.height = 60;
-  camera.K << 60, 0, 40, 0, 60, 30, 0, 0, 1;
+  const fusion::CameraModel camera = fixtures::pinholeCamera(80, 60, 60);
   PipelineSetup setup;
   setup.fuser = std::make_shared<const fusion::Fuser>(camera, Eigen::Isometry3d::Identity());
   auto detector = std::make_shared<RecordingDetector>();
-  std::mutex m;
-  std::condition_variable cv;
-  std::vector<std::uint64_t> delivered;
-  Pipeline pipeline(setup, detector, [&](std::shared_ptr<const StackResult> r) {
-    std::lock_guard lock(m);
-    delivered.push_back(r->stackId);
-    cv.notify_all();
-  });
+  fixtures::Results results;
+  Pipeline pipeline(setup, detector, results.handler());
   pipeline.start();
 
   // One scene: a few points 5 m ahead and a grey frame.
@@ -84,10 +75,7 @@ TEST(PipelineWarmUp, TheDetectorIsPreparedOnABlankStackOfTheRigBeforeTheFirstSta
   scene.frame.stride = 3 * camera.width;
   scene.frame.bytes.assign(static_cast<std::size_t>(scene.frame.stride * scene.frame.height), 100);
   pipeline.onScene(scene);
-  {
-    std::unique_lock lock(m);
-    ASSERT_TRUE(cv.wait_for(lock, std::chrono::seconds(20), [&] { return !delivered.empty(); }));
-  }
+  ASSERT_TRUE(results.waitFor(1, std::chrono::seconds(20)));
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   while (!pipeline.idle() && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -106,8 +94,9 @@ TEST(PipelineWarmUp, TheDetectorIsPreparedOnABlankStackOfTheRigBeforeTheFirstSta
   EXPECT_EQ(calls[1].what, "detect");
   EXPECT_EQ(calls[1].width, camera.width);
   // Nothing of the warm-up is delivered or counted: the scene is stack 0, and the only one.
-  std::lock_guard lock2(m);
-  EXPECT_EQ(delivered, std::vector<std::uint64_t>{0});
+  const std::vector<StackResult> delivered = results.all();
+  ASSERT_EQ(delivered.size(), 1u);
+  EXPECT_EQ(delivered[0].stackId, 0u);
   EXPECT_EQ(counters.stacksFused, 1u);
   EXPECT_EQ(counters.stacksDetected, 1u);
 }
