@@ -16,7 +16,7 @@ constexpr std::chrono::milliseconds kIdleWake{200};  // threads show liveness at
 
 // The first stack through a thread used to pay for what later ones reuse: fresh buffers (page
 // faults, zeroed pages). Measured in bench_daemon_latency (bench/README.md): the first stack's
-// integral tables 17 ms against 3 ms, its detection 78-85 ms against 38-57 ms, its fusion 12-17 ms
+// integral tables 17 ms against 3 ms, its detection 78-85 ms against 39-61 ms, its fusion 12-17 ms
 // against 7-9 ms - the p99 of a short run was that one stack. So the fusion thread fuses a blank
 // stack (a black image, an empty sweep) of the rig's sizes before its first real one, and the
 // detection thread readies the detector on one (StackDetector::prepare: the tables, no model
