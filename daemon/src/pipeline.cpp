@@ -18,19 +18,30 @@ constexpr std::chrono::milliseconds kIdleWake{200};  // threads show liveness at
 // faults, zeroed pages). Measured in bench_daemon_latency (bench/README.md): the first stack's
 // integral tables 17 ms against 3 ms, its detection 78-85 ms against 39-61 ms, its fusion 12-17 ms
 // against 7-9 ms - the p99 of a short run was that one stack. So the fusion thread fuses a blank
-// stack (a black image, an empty sweep) of the rig's sizes before its first real one, and the
-// detection thread readies the detector on one (StackDetector::prepare: the tables, no model
-// runs); nothing of it is counted, queued or delivered, and a failure only costs the warm-up.
+// stack (a black image, an empty sweep) of the rig's sizes before its first real one and hands it
+// to the detection thread, which readies the detector on it (StackDetector::prepare: the tables,
+// no model runs). Only the fusion thread fuses: two threads fusing at once raced inside OpenCV
+// (ThreadSanitizer). Nothing of it is counted, queued or delivered; a failure only costs the warm-up.
 void Pipeline::warmUp(WarmUp stage) {
   const char* name = stage == WarmUp::kFusion ? "fusion" : "detection";
+  const auto& p = setup_.fuser->projection();
   try {
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto& p = setup_.fuser->projection();
-    cv::Mat undistorted;
-    const LayerStack blank = setup_.fuser->fuseSensors(cv::Mat::zeros(p.height, p.width, CV_8UC3), fusion::Sweep{}, &undistorted);
-    if (stage == WarmUp::kDetection) detector()->prepare(blank);
-    spdlog::debug("{} warm-up on a blank {}x{} stack: {:.1f} ms", name, p.width, p.height,
-                  std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    if (stage == WarmUp::kFusion) {
+      cv::Mat undistorted;
+      std::shared_ptr<const LayerStack> blank;
+      try {
+        blank = std::make_shared<const LayerStack>(
+            setup_.fuser->fuseSensors(cv::Mat::zeros(p.height, p.width, CV_8UC3), fusion::Sweep{}, &undistorted));
+      } catch (...) {
+        blankStack_.set_value(nullptr);
+        throw;
+      }
+      blankStack_.set_value(blank);
+    } else {
+      const std::shared_ptr<const LayerStack> blank = blankStack_.get_future().get();
+      if (!blank) return;  // the fusion warm-up failed and said so
+      detector()->prepare(*blank);
+    }
   } catch (const std::exception& e) {
     spdlog::warn("{} warm-up on a blank stack: {} (its first stack runs cold)", name, e.what());
   }

@@ -28,6 +28,7 @@
 
 #include <atomic>
 #include <functional>
+#include <future>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -217,6 +218,7 @@ class Pipeline : public SensorSink {
   // Readies one thread's stage on a blank stack before its first real one (pipeline.cpp says why).
   enum class WarmUp { kFusion, kDetection };
   void warmUp(WarmUp stage);
+  std::promise<std::shared_ptr<const LayerStack>> blankStack_;  // fusion's warm-up -> detection's (null: none)
   // Pushes `fused` into `queue`; in lossless mode waits for room first, showing liveness in
   // `beat`. False when the pipeline stops meanwhile (the stack is dropped).
   bool handOver(BoundedQueue<FusedStack>& queue, FusedStack&& fused, std::atomic<std::int64_t>& beat);
