@@ -22,28 +22,26 @@ constexpr std::chrono::milliseconds kIdleWake{200};  // threads show liveness at
 // to the detection thread, which readies the detector on it (StackDetector::prepare: the tables,
 // no model runs). Only the fusion thread fuses: two threads fusing at once raced inside OpenCV
 // (ThreadSanitizer). Nothing of it is counted, queued or delivered; a failure only costs the warm-up.
-void Pipeline::warmUp(WarmUp stage) {
-  const char* name = stage == WarmUp::kFusion ? "fusion" : "detection";
-  const auto& p = setup_.fuser->projection();
+void Pipeline::warmUpFusion() {
+  std::shared_ptr<const LayerStack> blank;
   try {
-    if (stage == WarmUp::kFusion) {
-      cv::Mat undistorted;
-      std::shared_ptr<const LayerStack> blank;
-      try {
-        blank = std::make_shared<const LayerStack>(
-            setup_.fuser->fuseSensors(cv::Mat::zeros(p.height, p.width, CV_8UC3), fusion::Sweep{}, &undistorted));
-      } catch (...) {
-        blankStack_.set_value(nullptr);
-        throw;
-      }
-      blankStack_.set_value(blank);
-    } else {
-      const std::shared_ptr<const LayerStack> blank = blankStack_.get_future().get();
-      if (!blank) return;  // the fusion warm-up failed and said so
-      detector()->prepare(*blank);
-    }
+    const auto& p = setup_.fuser->projection();
+    cv::Mat undistorted;
+    blank = std::make_shared<const LayerStack>(
+        setup_.fuser->fuseSensors(cv::Mat::zeros(p.height, p.width, CV_8UC3), fusion::Sweep{}, &undistorted));
   } catch (const std::exception& e) {
-    spdlog::warn("{} warm-up on a blank stack: {} (its first stack runs cold)", name, e.what());
+    spdlog::warn("fusion warm-up on a blank stack: {} (the first stacks run cold)", e.what());
+  }
+  blankStack_.set_value(std::move(blank));
+}
+
+void Pipeline::warmUpDetection() {
+  const std::shared_ptr<const LayerStack> blank = blankStack_.get_future().get();
+  if (!blank) return;  // the fusion warm-up failed and said so
+  try {
+    detector()->prepare(*blank);
+  } catch (const std::exception& e) {
+    spdlog::warn("detection warm-up on a blank stack: {} (its first stack runs cold)", e.what());
   }
 }
 
@@ -153,7 +151,7 @@ bool Pipeline::idle() const {
 
 void Pipeline::fusionLoop() {
   nameThisThread("fd-fusion");
-  warmUp(WarmUp::kFusion);
+  warmUpFusion();
   while (!abandon_) {
     fusionBeat_ = Stamp::now().ns;
     auto message = sensorQueue_.pop(kIdleWake);
@@ -297,7 +295,7 @@ void Pipeline::detectionLoop() {
   // Made here: TBB observes the arena of the thread that creates the observer, and the scan's
   // helpers work in this thread's arena.
   const TbbWorkerNames helpers("fd-tbb");
-  warmUp(WarmUp::kDetection);
+  warmUpDetection();
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
   const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;
   while (!abandon_) {

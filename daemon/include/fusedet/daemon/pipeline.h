@@ -215,10 +215,11 @@ class Pipeline : public SensorSink {
   void fusionLoop();
   void networkLoop();
   void detectionLoop();
-  // Readies one thread's stage on a blank stack before its first real one (pipeline.cpp says why).
-  enum class WarmUp { kFusion, kDetection };
-  void warmUp(WarmUp stage);
-  std::promise<std::shared_ptr<const LayerStack>> blankStack_;  // fusion's warm-up -> detection's (null: none)
+  // Each thread's stage readied on a blank stack before its first real one (pipeline.cpp says why):
+  // fusion fuses it and hands it over in blankStack_ (null when that failed), detection prepares on it.
+  void warmUpFusion();
+  void warmUpDetection();
+  std::promise<std::shared_ptr<const LayerStack>> blankStack_;
   // Pushes `fused` into `queue`; in lossless mode waits for room first, showing liveness in
   // `beat`. False when the pipeline stops meanwhile (the stack is dropped).
   bool handOver(BoundedQueue<FusedStack>& queue, FusedStack&& fused, std::atomic<std::int64_t>& beat);
