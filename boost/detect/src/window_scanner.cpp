@@ -122,6 +122,10 @@ void setEarlyBounds(std::vector<GridStump>& stumps, std::size_t begin, std::size
 std::atomic<bool> gQuickDecisions{true};
 
 constexpr int kSpanStride = -1;  // GridScale::colStride of narrow irregular rows
+constexpr std::size_t kBand = 48;  // window columns per tile
+// Stage 0's whole steps per pass over a row, stump by stump (vector_stages.inc, rowStageSums()):
+// a band's row in four-lane steps.
+constexpr std::size_t kMaxRowSteps = kBand / 4;
 
 struct GridStage {
   std::uint32_t begin = 0, end = 0;
@@ -591,7 +595,6 @@ void onThreads(int threads, Work&& work) {
   }
 }
 
-constexpr std::size_t kBand = 48;  // window columns per tile
 constexpr std::size_t kTileWindows = 512;  // windows per tile (rows of a band): breadth-first unit
 
 // One tile: rows [y0, y1) x columns [x0, x1) of one scale, breadth-first; hits appended in (row,

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <thread>
 #include <tuple>
 
@@ -185,6 +186,68 @@ TEST(MultiDetector, ScalarFormEqualsVectorFormsWhereStageSumsTieTheThreshold) {
   }
   setVectorLanesLimit(8);
   EXPECT_GT(hits, 0u) << "thresholds on reachable sums should let some windows through";
+}
+
+// Stage 0 runs stump by stump over a row's steps, one loop per stump shape, table type and corner
+// load (vector_stages.inc, rowStageSums()); the bundled models' first stages read only the laser
+// layers with a few shapes. Here each model's stage 0 also takes the first stump of every (feature
+// type, layer) pair of the whole cascade, so stage 0 reads camera (int32) and laser or hue
+// (double) tables with every shape at every scale's loads, mixed loads in one stage included:
+// still every hit, score and stump count as the scalar form.
+TEST(MultiDetector, ScalarFormEqualsVectorFormsWithEveryShapeAndTableInStageZero) {
+  const LayerStack& s = kittiStacks().back();
+  std::vector<Cascade> models = bundledModels();
+  std::vector<std::size_t> firstSize;
+  std::set<FeatureType> types;
+  std::set<bool> eightBit;  // the stage-0 layers' kinds: 8-bit (int32 tables) or not (double)
+  for (Cascade& c : models) {
+    std::set<std::pair<FeatureType, int>> seen;
+    for (const Stump& t : c.stages.front().stumps)
+      seen.insert({c.features[static_cast<std::size_t>(t.feature)].type, c.features[static_cast<std::size_t>(t.feature)].layer});
+    std::vector<Stump> added;
+    for (std::size_t st = 1; st < c.stages.size(); ++st)
+      for (const Stump& t : c.stages[st].stumps) {
+        const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+        if (seen.insert({f.type, f.layer}).second) added.push_back(t);
+      }
+    auto& first = c.stages.front().stumps;
+    first.insert(first.end(), added.begin(), added.end());
+    firstSize.push_back(first.size());
+    for (const Stump& t : first) {
+      const Feature& f = c.features[static_cast<std::size_t>(t.feature)];
+      types.insert(f.type);
+      const auto* layer = s.find(c.layers[static_cast<std::size_t>(f.layer)]);  // none: hue_distance, made per class
+      eightBit.insert(layer && layer->data.depth() == CV_8U);
+    }
+  }
+  ASSERT_EQ(types.size(), kFeatureTypeCount) << "stage 0 should hold every feature type";
+  ASSERT_EQ(eightBit.size(), 2u) << "stage 0 should read int32 and double tables";
+  const MultiDetector all(models);
+  ScanParams p;
+  p.threads = 1;
+  std::vector<ScanStats> a;
+  setVectorScanEnabled(false);
+  const auto scalar = all.scan(s, p, &a);
+  setVectorScanEnabled(true);
+  for (bool quick : {true, false}) {
+    setQuickStumpDecisions(quick);
+    for (int lanes : {8, 4}) {
+      setVectorLanesLimit(lanes);
+      std::vector<ScanStats> b;
+      const auto vec = all.scan(s, p, &b);
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        expectSameHits(vec[i], scalar[i], all.cascade(i).className + " " + std::to_string(lanes) + " lanes, quick " + std::to_string(quick));
+        EXPECT_EQ(a[i].stumps, b[i].stumps) << all.cascade(i).className;
+      }
+    }
+  }
+  setQuickStumpDecisions(true);
+  setVectorLanesLimit(8);
+  for (std::size_t i = 0; i < all.size(); ++i) {  // stage 0 passes some windows and rejects others
+    const std::size_t second = models[i].stages[1].stumps.size();
+    EXPECT_GT(a[i].stumps, a[i].windows * firstSize[i]) << models[i].className;
+    EXPECT_LT(a[i].stumps, a[i].windows * (firstSize[i] + second)) << models[i].className;
+  }
 }
 
 // Layers whose values are NaN, infinite or huge in places: the vector forms' quick decisions (bounded
