@@ -126,6 +126,9 @@ constexpr std::size_t kBand = 48;  // window columns per tile
 // Stage 0's whole steps per pass over a row, stump by stump (vector_stages.inc, rowStageSums()):
 // a band's row in four-lane steps.
 constexpr std::size_t kMaxRowSteps = kBand / 4;
+// A later stage's steps per pass, stump by stump (laterStage()): a tile's windows (kTileWindows) in
+// four-lane steps.
+constexpr std::size_t kMaxLaterSteps = 128;
 
 struct GridStage {
   std::uint32_t begin = 0, end = 0;
