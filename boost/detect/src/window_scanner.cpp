@@ -126,9 +126,9 @@ constexpr std::size_t kBand = 48;  // window columns per tile
 // Stage 0's whole steps per pass over a row, stump by stump (vector_stages.inc, rowStageSums()):
 // a band's row in four-lane steps.
 constexpr std::size_t kMaxRowSteps = kBand / 4;
-// A later stage's steps per pass, stump by stump (laterStage()): a tile's windows (kTileWindows) in
-// four-lane steps.
-constexpr std::size_t kMaxLaterSteps = 128;
+constexpr std::size_t kTileWindows = 512;  // windows per tile (rows of a band): breadth-first unit
+// A later stage's steps per pass, stump by stump (laterStage()): a tile's windows in four-lane steps.
+constexpr std::size_t kMaxLaterSteps = kTileWindows / 4;
 
 struct GridStage {
   std::uint32_t begin = 0, end = 0;
@@ -598,7 +598,6 @@ void onThreads(int threads, Work&& work) {
   }
 }
 
-constexpr std::size_t kTileWindows = 512;  // windows per tile (rows of a band): breadth-first unit
 
 // One tile: rows [y0, y1) x columns [x0, x1) of one scale, breadth-first; hits appended in (row,
 // column) order.
