@@ -116,32 +116,42 @@ TEST(MultiDetector, AllClassesInOnePassDecideAsEachClassAloneOnRealKittiStacks) 
 // with AVX-512, four with AVX2; each where the CPU has it, else the next narrower one), with quick
 // stump decisions (products, exact fallback near the threshold) and with every stump on the
 // exact fallback.
-TEST(MultiDetector, ScalarFormEqualsVectorForms) {
-  const MultiDetector all(bundledModels());
+namespace {
+
+// The scalar form's hits on `s` (its stats in `stats`) against every vector form's, quick decisions
+// on and off: same hits, scores and stump counts.
+void expectVectorFormsEqualScalarForm(const MultiDetector& all, const LayerStack& s, std::vector<ScanStats>& stats) {
   ScanParams p;
   p.threads = 1;
-  for (const LayerStack& s : {kittiStacks().front(), kittiStacks().back()}) {
-    std::vector<ScanStats> a;
-    setVectorScanEnabled(false);
-    const auto scalar = all.scan(s, p, &a);
-    setVectorScanEnabled(true);
-    for (bool quick : {true, false}) {
-      setQuickStumpDecisions(quick);
-      for (int lanes : {8, 4}) {
-        setVectorLanesLimit(lanes);
-        // The path that runs: this one where the CPU has it, else the CPU's widest below it.
-        EXPECT_EQ(dispatchedVectorLanes(), std::min(lanes, cpuVectorLanes() >= 4 ? cpuVectorLanes() : 1));
-        std::vector<ScanStats> b;
-        const auto vec = all.scan(s, p, &b);
-        for (std::size_t i = 0; i < all.size(); ++i) {
-          expectSameHits(vec[i], scalar[i],
-                         all.cascade(i).className + " " + std::to_string(lanes) + " lanes, quick " + std::to_string(quick));
-          EXPECT_EQ(a[i].stumps, b[i].stumps);
-        }
+  setVectorScanEnabled(false);
+  const auto scalar = all.scan(s, p, &stats);
+  setVectorScanEnabled(true);
+  for (bool quick : {true, false}) {
+    setQuickStumpDecisions(quick);
+    for (int lanes : {8, 4}) {
+      setVectorLanesLimit(lanes);
+      // The path that runs: this one where the CPU has it, else the CPU's widest below it.
+      EXPECT_EQ(dispatchedVectorLanes(), std::min(lanes, cpuVectorLanes() >= 4 ? cpuVectorLanes() : 1));
+      std::vector<ScanStats> b;
+      const auto vec = all.scan(s, p, &b);
+      for (std::size_t i = 0; i < all.size(); ++i) {
+        expectSameHits(vec[i], scalar[i],
+                       all.cascade(i).className + " " + std::to_string(lanes) + " lanes, quick " + std::to_string(quick));
+        EXPECT_EQ(stats[i].stumps, b[i].stumps) << all.cascade(i).className;
       }
     }
-    setQuickStumpDecisions(true);
-    setVectorLanesLimit(8);
+  }
+  setQuickStumpDecisions(true);
+  setVectorLanesLimit(8);
+}
+
+}  // namespace
+
+TEST(MultiDetector, ScalarFormEqualsVectorForms) {
+  const MultiDetector all(bundledModels());
+  for (const LayerStack& s : {kittiStacks().front(), kittiStacks().back()}) {
+    std::vector<ScanStats> stats;
+    expectVectorFormsEqualScalarForm(all, s, stats);
   }
 }
 
@@ -223,26 +233,8 @@ TEST(MultiDetector, ScalarFormEqualsVectorFormsWithEveryShapeAndTableInStageZero
   ASSERT_EQ(types.size(), kFeatureTypeCount) << "stage 0 should hold every feature type";
   ASSERT_EQ(eightBit.size(), 2u) << "stage 0 should read int32 and double tables";
   const MultiDetector all(models);
-  ScanParams p;
-  p.threads = 1;
   std::vector<ScanStats> a;
-  setVectorScanEnabled(false);
-  const auto scalar = all.scan(s, p, &a);
-  setVectorScanEnabled(true);
-  for (bool quick : {true, false}) {
-    setQuickStumpDecisions(quick);
-    for (int lanes : {8, 4}) {
-      setVectorLanesLimit(lanes);
-      std::vector<ScanStats> b;
-      const auto vec = all.scan(s, p, &b);
-      for (std::size_t i = 0; i < all.size(); ++i) {
-        expectSameHits(vec[i], scalar[i], all.cascade(i).className + " " + std::to_string(lanes) + " lanes, quick " + std::to_string(quick));
-        EXPECT_EQ(a[i].stumps, b[i].stumps) << all.cascade(i).className;
-      }
-    }
-  }
-  setQuickStumpDecisions(true);
-  setVectorLanesLimit(8);
+  expectVectorFormsEqualScalarForm(all, s, a);
   for (std::size_t i = 0; i < all.size(); ++i) {  // stage 0 passes some windows and rejects others
     const std::size_t second = models[i].stages[1].stumps.size();
     EXPECT_GT(a[i].stumps, a[i].windows * firstSize[i]) << models[i].className;
