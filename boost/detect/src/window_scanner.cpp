@@ -598,7 +598,6 @@ void onThreads(int threads, Work&& work) {
   }
 }
 
-
 // One tile: rows [y0, y1) x columns [x0, x1) of one scale, breadth-first; hits appended in (row,
 // column) order.
 void scanTile(const GridScale& sp, const void* const* grids, std::size_t ng, std::size_t x0, std::size_t x1,

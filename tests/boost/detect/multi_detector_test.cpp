@@ -112,10 +112,6 @@ TEST(MultiDetector, AllClassesInOnePassDecideAsEachClassAloneOnRealKittiStacks) 
   EXPECT_GT(referenceHits, 20u) << "the bundled models should accept some windows on these frames";
 }
 
-// The one-window scalar form of the new scanner decides the same as its vector forms (eight lanes
-// with AVX-512, four with AVX2; each where the CPU has it, else the next narrower one), with quick
-// stump decisions (products, exact fallback near the threshold) and with every stump on the
-// exact fallback.
 namespace {
 
 // The scalar form's hits on `s` (its stats in `stats`) against every vector form's, quick decisions
@@ -147,6 +143,10 @@ void expectVectorFormsEqualScalarForm(const MultiDetector& all, const LayerStack
 
 }  // namespace
 
+// The one-window scalar form of the new scanner decides the same as its vector forms (eight lanes
+// with AVX-512, four with AVX2; each where the CPU has it, else the next narrower one), with quick
+// stump decisions (products, exact fallback near the threshold) and with every stump on the
+// exact fallback.
 TEST(MultiDetector, ScalarFormEqualsVectorForms) {
   const MultiDetector all(bundledModels());
   for (const LayerStack& s : {kittiStacks().front(), kittiStacks().back()}) {
