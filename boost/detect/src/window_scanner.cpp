@@ -13,6 +13,7 @@
 #include <limits>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include "fusedet/boost/float_cut.h"
 #include "fusedet/boost/parallel_for.h"
@@ -158,6 +159,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
   const std::size_t ng = in.grids().size();
   sp.colOfs.resize(ng);
   sp.rowOfs.resize(ng);
+  sp.colStride.reserve(ng);
   std::vector<std::array<int, 2>> lwSize(ng);
   for (std::size_t g = 0; g < ng; ++g) {
     const IntegralGrid& gr = in.grids()[g];
@@ -167,6 +169,8 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     geometry.height = gr.height;
     lwSize[g] = layerWindowSize(geometry, W, H, win.winW, win.winH);
     const double sx = double(gr.width) / W, sy = double(gr.height) / H;
+    sp.colOfs[g].reserve(win.xs.size() + 8);
+    sp.rowOfs[g].reserve(win.ys.size());
     for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
     const auto& co = sp.colOfs[g];
     sp.colStride.push_back(0);
@@ -185,6 +189,10 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     for (int y : win.ys)
       sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
   }
+  std::size_t stumps = 0;
+  for (const Stage& st : c.stages) stumps += st.stumps.size();
+  sp.stumps.reserve(stumps);  // built in place: a GridStump is a few cache lines
+  sp.stages.reserve(c.stages.size());
   for (const Stage& st : c.stages) {
     GridStage gs{static_cast<std::uint32_t>(sp.stumps.size()), 0, st.threshold};
     for (const Stump& t : st.stumps) {
@@ -200,7 +208,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
                                            static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x0),
                                            static_cast<std::int32_t>(slot0 + r.y1 * gr.pitch + r.x1)};
       };
-      GridStump z;
+      GridStump& z = sp.stumps.emplace_back();
       z.grid = ref.grid;
       z.intGrid = gr.exactInt;
       z.checker = lay.blackCount == 2;
@@ -220,7 +228,6 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       setQuickBounds(z, gr, ref.slot, lay, floatCut(z.threshold), quick);
       z.left = t.left;
       z.right = t.right;
-      sp.stumps.push_back(z);
     }
     gs.end = static_cast<std::uint32_t>(sp.stumps.size());
     if (gs.end > gs.begin) setEarlyBounds(sp.stumps, gs.begin, gs.end, st.threshold, &st == &c.stages.back());
@@ -712,9 +719,12 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   // then position, then cascade: the models' tiles over the same part of the image follow each
   // other, so the integral rows one brings into the cache serve the next.
   struct Item {
-    std::size_t cascade, scale, x0, x1, y0, y1;
-    std::tuple<std::size_t, int, int, std::size_t> place;  // (scale, top, left, cascade): unique
+    std::uint32_t cascade, scale, x0, x1, y0, y1;
+    // (scale, top, left, cascade), unique, packed in two words: one comparison each (the sort of
+    // thousands of tiles is part of every scan)
+    std::pair<std::uint64_t, std::uint64_t> place;
   };
+  auto word = [](std::size_t high, std::size_t low) { return std::uint64_t(high) << 32 | std::uint64_t(low); };
   std::vector<Item> items;
   for (std::size_t c = 0; c < nc; ++c)
     for (std::size_t s = 0; s < plans[c].size(); ++s) {
@@ -722,8 +732,12 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
       for (std::size_t x0 = 0; x0 < w.xs.size(); x0 += kBand) {
         const std::size_t x1 = std::min(w.xs.size(), x0 + kBand);
         const std::size_t rows = std::max<std::size_t>(1, kTileWindows / (x1 - x0));
-        for (std::size_t y0 = 0; y0 < w.ys.size(); y0 += rows)
-          items.push_back(Item{c, s, x0, x1, y0, std::min(w.ys.size(), y0 + rows), {s, w.ys[y0], w.xs[x0], c}});
+        for (std::size_t y0 = 0; y0 < w.ys.size(); y0 += rows) {
+          const std::size_t y1 = std::min(w.ys.size(), y0 + rows);
+          const auto top = static_cast<std::size_t>(w.ys[y0]), left = static_cast<std::size_t>(w.xs[x0]);
+          items.push_back(Item{std::uint32_t(c), std::uint32_t(s), std::uint32_t(x0), std::uint32_t(x1), std::uint32_t(y0),
+                               std::uint32_t(y1), {word(s, top), word(left, c)}});
+        }
       }
     }
   std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.place < b.place; });
