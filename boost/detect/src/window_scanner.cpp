@@ -171,7 +171,8 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     const double sx = double(gr.width) / W, sy = double(gr.height) / H;
     sp.colOfs[g].reserve(win.xs.size() + 8);
     sp.rowOfs[g].reserve(win.ys.size());
-    for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
+    // A grid of the reference size maps each position to itself (x * 1.0 rounds to x).
+    for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(gr.width == W ? x : roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
     const auto& co = sp.colOfs[g];
     sp.colStride.push_back(0);
     if (co.size() > 1 && co[1] > co[0]) {
@@ -187,7 +188,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     }
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
     for (int y : win.ys)
-      sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
+      sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(gr.height == H ? y : roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
   }
   std::size_t stumps = 0;
   for (const Stage& st : c.stages) stumps += st.stumps.size();
@@ -726,6 +727,13 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
   };
   auto word = [](std::size_t high, std::size_t low) { return std::uint64_t(high) << 32 | std::uint64_t(low); };
   std::vector<Item> items;
+  // Tiles at most: a narrower last band only has taller tiles.
+  constexpr std::size_t kFewestRows = std::max<std::size_t>(1, kTileWindows / kBand);
+  std::size_t most = 0;
+  for (std::size_t c = 0; c < nc; ++c)
+    for (const GridScale& sp : plans[c])
+      most += (sp.win.xs.size() + kBand - 1) / kBand * ((sp.win.ys.size() + kFewestRows - 1) / kFewestRows);
+  items.reserve(most);
   for (std::size_t c = 0; c < nc; ++c)
     for (std::size_t s = 0; s < plans[c].size(); ++s) {
       const ScaleWindows& w = plans[c][s].win;
