@@ -172,7 +172,8 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     sp.colOfs[g].reserve(win.xs.size() + 8);
     sp.rowOfs[g].reserve(win.ys.size());
     // A grid of the reference size maps each position to itself (x * 1.0 rounds to x).
-    for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(gr.width == W ? x : roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
+    for (int x : win.xs)
+      sp.colOfs[g].push_back(std::clamp(gr.width == W ? x : roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
     const auto& co = sp.colOfs[g];
     sp.colStride.push_back(0);
     if (co.size() > 1 && co[1] > co[0]) {
@@ -187,8 +188,10 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
       if (narrow) sp.colStride.back() = kSpanStride;
     }
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
-    for (int y : win.ys)
-      sp.rowOfs[g].push_back(static_cast<std::int32_t>(std::clamp(gr.height == H ? y : roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]) * gr.pitch));
+    for (int y : win.ys) {
+      const int row = std::clamp(gr.height == H ? y : roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]);
+      sp.rowOfs[g].push_back(static_cast<std::int32_t>(row * gr.pitch));
+    }
   }
   std::size_t stumps = 0;
   for (const Stage& st : c.stages) stumps += st.stumps.size();
@@ -725,7 +728,7 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
     // thousands of tiles is part of every scan)
     std::pair<std::uint64_t, std::uint64_t> place;
   };
-  auto word = [](std::size_t high, std::size_t low) { return std::uint64_t(high) << 32 | std::uint64_t(low); };
+  auto word = [](std::size_t high, std::size_t low) { return std::uint64_t(high) << 32 | low; };
   std::vector<Item> items;
   // Tiles at most: a narrower last band only has taller tiles.
   constexpr std::size_t kFewestRows = std::max<std::size_t>(1, kTileWindows / kBand);
@@ -743,8 +746,8 @@ std::vector<std::vector<RawHit>> scanCascades(const std::vector<const Cascade*>&
         for (std::size_t y0 = 0; y0 < w.ys.size(); y0 += rows) {
           const std::size_t y1 = std::min(w.ys.size(), y0 + rows);
           const auto top = static_cast<std::size_t>(w.ys[y0]), left = static_cast<std::size_t>(w.xs[x0]);
-          items.push_back(Item{std::uint32_t(c), std::uint32_t(s), std::uint32_t(x0), std::uint32_t(x1), std::uint32_t(y0),
-                               std::uint32_t(y1), {word(s, top), word(left, c)}});
+          items.push_back(Item{std::uint32_t(c), std::uint32_t(s), std::uint32_t(x0), std::uint32_t(x1),
+                               std::uint32_t(y0), std::uint32_t(y1), {word(s, top), word(left, c)}});
         }
       }
     }
