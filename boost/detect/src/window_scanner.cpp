@@ -171,9 +171,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     const double sx = double(gr.width) / W, sy = double(gr.height) / H;
     sp.colOfs[g].reserve(win.xs.size() + 8);
     sp.rowOfs[g].reserve(win.ys.size());
-    // A grid of the reference size maps each position to itself (x * 1.0 rounds to x).
-    for (int x : win.xs)
-      sp.colOfs[g].push_back(std::clamp(gr.width == W ? x : roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
+    for (int x : win.xs) sp.colOfs[g].push_back(std::clamp(roundHalfUp(x * sx), 0, gr.width - lwSize[g][0]));
     const auto& co = sp.colOfs[g];
     sp.colStride.push_back(0);
     if (co.size() > 1 && co[1] > co[0]) {
@@ -189,7 +187,7 @@ GridScale planScale(const Cascade& c, const IntegralGrids& in, const std::vector
     }
     sp.colOfs[g].insert(sp.colOfs[g].end(), 8, sp.colOfs[g].back());  // padding for eight-lane loads
     for (int y : win.ys) {
-      const int row = std::clamp(gr.height == H ? y : roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]);
+      const int row = std::clamp(roundHalfUp(y * sy), 0, gr.height - lwSize[g][1]);
       sp.rowOfs[g].push_back(static_cast<std::int32_t>(row * gr.pitch));
     }
   }
