@@ -4,9 +4,12 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
+#include <optional>
+#include <string>
 #include <opencv2/core/utility.hpp>
 
 #include "fusedet/core/cpu_time.h"
+#include "fusedet/daemon/thread_placement.h"
 #include "fusedet/fusion/frame_decode.h"
 
 namespace fusedet::daemon {
@@ -295,6 +298,17 @@ void Pipeline::detectionLoop() {
   // Made here: TBB observes the arena of the thread that creates the observer, and the scan's
   // helpers work in this thread's arena.
   const TbbWorkerNames helpers("fd-tbb");
+  std::optional<DetectionPinning> pinning;
+  if (setup_.pinDetection) {
+    pinning.emplace();
+    if (pinning->active()) {
+      std::string list;
+      for (const int c : pinning->cpus()) list += (list.empty() ? "" : " ") + std::to_string(c);
+      spdlog::info("detection threads pinned, one per CPU of {} (the detection thread on CPU {})", list,
+                   pinning->cpus().front());
+    } else
+      spdlog::info("detection threads not pinned: {}", pinning->reason());
+  }
   warmUpDetection();
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
   const Eigen::Isometry3d sweepToCamera = setup_.fuser->projection().sweepToCamera;

@@ -103,6 +103,7 @@ PipelineSetup pipelineSetup(ServiceParts& parts) {
   setup.maxPairSkewNs = std::int64_t{sensors.fusion.maxPairSkewMs} * 1'000'000;
   setup.lossless = parts.lossless;
   setup.tracking = parts.config.tracking;
+  setup.pinDetection = parts.config.detection.threads == 0;
   return setup;
 }
 

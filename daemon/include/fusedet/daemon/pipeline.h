@@ -121,6 +121,10 @@ struct PipelineSetup {
   // Each result carries its layers and sweep (StackResult::view) for the live view: the layers
   // are handed over after detection (no copy), the sweep's points are copied once.
   bool keepViews = false;
+  // The detection thread and the scan's helpers each on a CPU of their own (thread_placement.h):
+  // pipelineSetup() sets it when detection.threads is 0 (the helpers work in the detection
+  // thread's arena); decided at start.
+  bool pinDetection = false;
 };
 
 struct PipelineCounters {
