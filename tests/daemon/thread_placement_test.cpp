@@ -104,7 +104,9 @@ TEST(ThreadPlacement, PinsTheThreadAndEachHelperToTheirOwnCpu) {
     ASSERT_GE(s.slot, 0);
     EXPECT_EQ(s.cpus, std::set<int>{cpus[static_cast<std::size_t>(s.slot) % cpus.size()]})
         << "thread " << s.tid << " in slot " << s.slot;
-    if (s.tid == caller) EXPECT_EQ(s.slot, 0);
+    if (s.tid == caller) {
+      EXPECT_EQ(s.slot, 0);
+    }
   }
   ASSERT_NE(worker, 0);
   EXPECT_EQ(workerAfter, all) << "worker " << worker << " still pinned 5 s after the loop";
