@@ -132,6 +132,10 @@ Service::~Service() { stop(std::chrono::steady_clock::now()); }
 
 void Service::start() {
   startedNs_ = Stamp::now().ns;
+  // spdlog's logger registry is made on first use; made here, before the threads that log at
+  // their start (server, detection), they need not race to make it (ThreadSanitizer cannot see
+  // the guard of that static inside libspdlog and reported the two first uses as a race).
+  spdlog::default_logger_raw();
   server_->start();
   if (live_) live_->start();
   pipeline_->start();
