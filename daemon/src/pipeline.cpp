@@ -306,8 +306,9 @@ void Pipeline::detectionLoop() {
       for (const int c : pinning->cpus()) list += (list.empty() ? "" : " ") + std::to_string(c);
       spdlog::info("detection threads pinned, one per CPU of {} (the detection thread on CPU {})", list,
                    pinning->cpus().front());
-    } else
+    } else {
       spdlog::info("detection threads not pinned: {}", pinning->reason());
+    }
   }
   warmUpDetection();
   const Eigen::Matrix3d K = setup_.fuser->projection().K;
