@@ -26,6 +26,7 @@
 #include <sstream>
 #include <thread>
 
+#include "../process_temp_dir.h"
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/run.h"
 #include "replay_logs.h"
@@ -41,7 +42,7 @@ namespace {
 const std::string kDaemon = std::string(FUSEDET_BINARY_DIR) + "/tools/fusedetd";
 
 fs::path tempDir(const std::string& name) {
-  auto dir = fs::temp_directory_path() / ("fusedetd-" + name + "-" + std::to_string(::getpid()));
+  const fs::path dir = fusedet::test::processTempDir() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir;

@@ -11,6 +11,7 @@
 #include <map>
 #include <thread>
 
+#include "../process_temp_dir.h"
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/offline_replay.h"
 #include "fusedet/daemon/protocol.h"
@@ -33,9 +34,7 @@ namespace {
 constexpr int kStrokes = 3;  // strokes in the test log = stacks per pass
 
 std::string tempSocket(const std::string& name) {
-  auto dir = fs::temp_directory_path() / ("fusedet-replay-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return (dir / name).string();
+  return (test::processTempDir() / name).string();
 }
 
 std::string model(const std::string& cls) { return std::string(FUSEDET_SOURCE_DIR) + "/models/" + cls + ".json"; }

@@ -3,20 +3,16 @@
 // What the socket server tests feed the server: a socket path in a folder of this test process,
 // and synthetic stack results (no detection cost, so the tests are about the server).
 
-#include <unistd.h>
-
-#include <filesystem>
 #include <memory>
 #include <string>
 
+#include "../process_temp_dir.h"
 #include "fusedet/daemon/pipeline.h"
 
 namespace fusedet::daemon::server_test {
 
 inline std::string tempSocket(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("fusedet-test-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  return (test::processTempDir() / name).string();
 }
 
 // Stack `id` stamped now with `detections` boxes, cars and bikes in turn (10: ~1.5 kB per line).

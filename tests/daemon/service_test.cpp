@@ -15,6 +15,7 @@
 #include <thread>
 #include <utility>
 
+#include "../process_temp_dir.h"
 #include "fusedet/daemon/client.h"
 #include "fusedet/daemon/service.h"
 #include "fusedet/daemon/service_parts.h"
@@ -30,9 +31,7 @@ using namespace std::chrono_literals;
 namespace {
 
 std::string tempSocket(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("fusedet-svc-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return (dir / name).string();
+  return (test::processTempDir() / name).string();
 }
 
 std::filesystem::path kittiRoot() { return std::filesystem::path(FUSEDET_DATA_DIR) / "kitti"; }

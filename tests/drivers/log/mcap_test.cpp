@@ -11,6 +11,7 @@
 #include <random>
 #include <set>
 
+#include "../../process_temp_dir.h"
 #include "fusedet/drivers/log/mcap_reader.h"
 #include "fusedet/drivers/log/mcap_writer.h"
 
@@ -20,9 +21,7 @@ using namespace fusedet::drivers::mcap;
 namespace {
 
 fs::path tempFile(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("fusedet_mcap_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
+  return fusedet::test::processTempDir() / name;
 }
 
 std::vector<std::uint8_t> readBytes(const fs::path& p) {
