@@ -322,9 +322,8 @@ const bool registered = registerCommand(
       app.add_option("--layers", o->layers,
                      "comma-separated layers of the joint feature pool; hue_distance is derived from hue "
                      "with the class's reference hue (computed from the positives and stored in the model); "
-                     "neural_person, neural_bicycle, neural_car where the data set was imported with "
-                     "--network, neural_feature_<k> with --network-features (the model records that network, "
-                     "and detection then needs the same one)")
+                     "neural_person, neural_bicycle, neural_car where the data set was imported with --network "
+                     "(the model records that network, and detection then needs the same one)")
           ->capture_default_str();
       app.add_option("--types", o->types,
                      "feature types of the pool: letters a-j (paper Fig. 1) and ranges, e.g. a-f (no corner "

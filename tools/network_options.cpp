@@ -9,7 +9,6 @@ fusion::NeuralLayerOptions NetworkOptions::layerOptions() const {
   o.files = files;
   o.directory = directory;
   o.input = fusion::parseInputSize(input);
-  o.features = features;
   return o;
 }
 
@@ -24,7 +23,6 @@ std::string NetworkOptions::commandLine() const {
   for (const auto& f : files) c += " --network-file " + f.string();
   c += " --network-input " + input;
   if (!directory.empty()) c += " --networks-dir " + directory.string();
-  if (features > 0) c += " --network-features " + std::to_string(features);
   return c;
 }
 
@@ -40,12 +38,6 @@ void addNetworkOptions(CLI::App& app, NetworkOptions& o, const std::string& what
                  "the network's files (darknet: the cfg, then the weights; yolov5-onnx: the .onnx), relative "
                  "ones in --networks-dir; default: yolo-fastest-1.1-xl.cfg + .weights, or yolov5n_256x832.onnx");
   app.add_option("--network-input", o.input, "the network's input size W x H (darknet: multiples of 32)")
-      ->capture_default_str();
-  app.add_option("--network-features", o.features,
-                 "also this many backbone feature channels as layers neural_feature_0, 1, ... (the channels "
-                 "of the map the finest detection head reads that it weighs most for objectness; "
-                 "fusion/neural/feature_layers.h); 0 = none")
-      ->check(CLI::Range(0, 256))
       ->capture_default_str();
   app.add_option("--networks-dir", o.directory,
                  "where the network files are: default $FUSEDET_NETWORKS_DIR, else /usr/share/fusedet/networks");

@@ -3,7 +3,7 @@
 // The options that name the network whose score layers a stack gets (fusion/neural/neural_layers.h),
 // defined once for `fusedet import-kitti`, `fusedet detect` and `fusedet experiments`:
 // --network KIND (none = off, the default), --network-file FILE (repeatable; default: the kind's
-// files in the networks folder), --network-input WxH, --network-features N (0 = none), --networks-dir DIR.
+// files in the networks folder), --network-input WxH, --networks-dir DIR.
 
 #include <CLI/CLI.hpp>
 #include <filesystem>
@@ -20,7 +20,6 @@ struct NetworkOptions {
   std::vector<std::filesystem::path> files;
   std::string input = "832x256";
   std::filesystem::path directory;  // empty: fusion::defaultNetworksDir()
-  int features = 0;                 // backbone feature channels (--network-features)
 
   bool enabled() const { return kind != "none"; }
   fusion::NeuralLayerOptions layerOptions() const;

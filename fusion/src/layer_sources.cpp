@@ -3,7 +3,6 @@
 
 #include "fusedet/core/layer_stack.h"
 #include "fusedet/core/network_record.h"
-#include "fusedet/fusion/neural/feature_layers.h"
 #include "fusedet/fusion/neural/score_layers.h"
 
 namespace fusedet::fusion {
@@ -39,15 +38,6 @@ const std::vector<std::string>& networkPoolLayers() {
   static const std::vector<std::string> l = [] {
     std::vector<std::string> names;
     for (const ScoreLayerClass& c : defaultScoreLayers()) names.push_back(c.layer);
-    return names;
-  }();
-  return l;
-}
-
-const std::vector<std::string>& networkFeatureLayers() {
-  static const std::vector<std::string> l = [] {
-    std::vector<std::string> names;
-    for (int rank = 0; rank < kPoolFeatureChannels; ++rank) names.push_back(featureLayerName(rank));
     return names;
   }();
   return l;

@@ -12,6 +12,7 @@
 #include "fusedet/fusion/datasets/kitti_drives.h"
 #include "fusedet/fusion/datasets/kitti_import.h"
 #include "fusedet/fusion/datasets/kitti_tracks.h"
+#include "fusedet/fusion/layer_sources.h"
 
 namespace fusedet::tools::experiments {
 std::vector<fs::path> kittiDrives(const fs::path& root) {
@@ -51,7 +52,6 @@ fs::path resolveDataset(const ExperimentOptions& o) {
   import.neural = o.network.load();
   if (import.neural) {
     signature += "network " + import.neural->identity().text() + "\n";
-    if (o.network.features > 0) signature += "features " + std::to_string(o.network.features) + "\n";
     std::printf("network %s\n", import.neural->identity().text().c_str());
   }
   const fs::path marker = cache / "imported-from.txt";
@@ -107,10 +107,10 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
 }
 
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   const std::vector<std::string>& driveOf,
-                                   const std::vector<std::string>& networkLayers) {
+                                   const std::vector<std::string>& driveOf, bool withNetwork) {
   std::vector<std::string> layers = {"red", "green", "blue", "intensity", "hue", "distance", "remission"};
-  layers.insert(layers.end(), networkLayers.begin(), networkLayers.end());
+  if (withNetwork)
+    for (const std::string& l : fusion::networkPoolLayers()) layers.push_back(l);
   std::vector<DatasetItem> items;
   items.reserve(entries.size());
   for (std::size_t i = 0; i < entries.size(); ++i) {

@@ -30,10 +30,9 @@ std::vector<std::vector<std::string>> objectIdsOf(const ExperimentOptions& o, co
                                                   const std::vector<Labels>& labels,
                                                   const std::vector<std::string>& driveOf);
 
-// Items with their raw drive as group (the folds are drive-disjoint): the paper's layers as stored
-// (hue, not hue_distance) and `networkLayers`.
+// Items with their raw drive as group (the folds are drive-disjoint); the network's score layers
+// too when `withNetwork`.
 std::vector<DatasetItem> loadItems(const fs::path& dataset, const std::vector<DatasetEntry>& entries,
-                                   const std::vector<std::string>& driveOf,
-                                   const std::vector<std::string>& networkLayers);
+                                   const std::vector<std::string>& driveOf, bool withNetwork);
 
 }  // namespace fusedet::tools::experiments

@@ -1,12 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "options.h"
 
-#include <algorithm>
 #include <functional>
 #include <stdexcept>
 
 #include "fusedet/boost/data_split.h"
-#include "fusedet/core/network_record.h"
 #include "fusedet/fusion/layer_sources.h"
 #include "text.h"
 
@@ -34,13 +32,6 @@ std::vector<std::string> poolWithNetwork() {
   return l;
 }
 
-// And the network's backbone feature channels.
-std::vector<std::string> poolWithNetworkFeatures() {
-  std::vector<std::string> l = poolWithNetwork();
-  for (const std::string& n : fusion::networkFeatureLayers()) l.push_back(n);
-  return l;
-}
-
 const std::vector<TrainedConfig>& trainedConfigs() {
   static const std::vector<TrainedConfig> c = {
       {"all", fusion::paperPoolLayers(), "a-j"},
@@ -50,7 +41,6 @@ const std::vector<TrainedConfig>& trainedConfigs() {
       {"four", {"hue_distance", "intensity", "distance", "remission"}, "a-j"},
       {"all_neural", poolWithNetwork(), "a-j"},
       {"neural", fusion::networkPoolLayers(), "a-j"},
-      {"all_neural_features", poolWithNetworkFeatures(), "a-j"},
   };
   return c;
 }
@@ -58,23 +48,14 @@ const std::vector<TrainedConfig>& trainedConfigs() {
 const TrainedConfig& trainedConfig(const std::string& name) {
   for (const TrainedConfig& t : trainedConfigs())
     if (t.name == name) return t;
-  throw std::runtime_error(
-      "unknown configuration '" + name +
-      "' (all, no_corners, laser, camera, four, and, all_neural, neural, all_neural_features)");
-}
-
-std::vector<std::string> networkLayersOf(const std::vector<std::string>& configs) {
-  std::vector<std::string> layers;
-  for (const std::string& c : configs)
-    if (c != "and")
-      for (const std::string& l : trainedConfig(c).layers)
-        if (isNetworkLayer(l) && std::find(layers.begin(), layers.end(), l) == layers.end())
-          layers.push_back(l);
-  return layers;
+  throw std::runtime_error("unknown configuration '" + name +
+                           "' (all, no_corners, laser, camera, four, and, all_neural, neural)");
 }
 
 bool needsNetwork(const std::vector<std::string>& configs) {
-  return !networkLayersOf(configs).empty();
+  for (const std::string& c : configs)
+    if (c != "and" && usesNetworkLayers(trainedConfig(c).layers)) return true;
+  return false;
 }
 
 std::vector<std::size_t> parseLearningCounts(const std::vector<std::string>& values, const std::string& option) {
@@ -230,15 +211,12 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
       ->capture_default_str();
   app.add_flag_callback("--quick", [o] { o->preset = "quick"; }, "the same as --preset quick");
   app.add_option("--classes", o->classes, "classes to run, in table order")->delimiter(',')->capture_default_str();
-  app.add_option(
-         "--configs", o->configs,
-         "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
-         "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
-         "remission), and (laser AND camera; trains both), all_neural (all + the network's score layers "
-         "neural_person, neural_bicycle, neural_car; needs --network), neural (the score layers alone), "
-         "all_neural_features (all_neural + 8 backbone feature channels neural_feature_0 .. 7; needs "
-         "--network-features 8)" +
-             presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
+  app.add_option("--configs", o->configs,
+                 "configurations: all (all layers, features a-j), no_corners (a-f), laser (distance, "
+                 "remission), camera (intensity, hue_distance), four (hue_distance, intensity, distance, "
+                 "remission), and (laser AND camera; trains both), all_neural (all + the network's score layers "
+                 "neural_person, neural_bicycle, neural_car; needs --network), neural (the score layers alone)" +
+                     presets([](const boosting::ExperimentPlan& p) { return joined(p.configs, ","); }))
       ->delimiter(',');
   app.add_option("--config-classes", o->configClasses,
                  "classes the configurations other than `all` run for (`all` runs for every class)" +
@@ -339,10 +317,9 @@ void addExperimentOptions(CLI::App& app, const std::shared_ptr<ExperimentOptions
                "own settings (fusedet/boost/class_detection.h: the daemon's scan 1.1 / 2, more neighbours, "
                "laser extent; docs/results \"Car at IoU 0.7\"), and any of those four options given applies to "
                "every class");
-  addNetworkOptions(
-      app, o->network,
-      "Needed by the configurations all_neural, neural and all_neural_features: the KITTI drives are "
-      "imported with the network's layers (a cache per network and feature count).");
+  addNetworkOptions(app, o->network,
+                    "Needed by the configurations all_neural and neural: the KITTI drives are imported with the "
+                    "network's layers (a cache per network).");
   app.add_option("--class-stages", o->classStagesText,
          "per-class stage count, e.g. person=5,bike=4: that class's cascades keep only their first N trained "
          "stages in every configuration and the learning curve (the same cascades as training with a stage "

@@ -78,9 +78,7 @@ const std::vector<TrainedConfig>& trainedConfigs();
 
 const TrainedConfig& trainedConfig(const std::string& name);
 
-// The network's layers the configurations train on, in their order (none: empty).
-std::vector<std::string> networkLayersOf(const std::vector<std::string>& configs);
-// Whether any configuration of the plan trains on the network's layers.
+// Whether any configuration of the plan trains on the network's score layers.
 bool needsNetwork(const std::vector<std::string>& configs);
 
 // "1,2,all" / "none" -> {1, 2, 0}: the counts of a learning curve (0 = all).

@@ -74,20 +74,14 @@ std::string formatEstimate(const Estimate& e, int decimals) {
 
 const std::vector<ConfigInfo>& paperConfigs() {
   static const std::vector<ConfigInfo> c = {
-      {"all",
-       "Tab. 2: all layers (red, green, blue, intensity, hue distance, distance, remission), features a-j"},
+      {"all", "Tab. 2: all layers (red, green, blue, intensity, hue distance, distance, remission), features a-j"},
       {"no_corners", "Tab. 3: all layers without the corner-like features (a-f only)"},
       {"laser", "Tab. 4: laser only (distance, remission)"},
       {"camera", "Tab. 5: camera only (intensity, hue distance)"},
       {"four", "Tab. 6: hue distance, intensity, distance, remission"},
       {"and", "Tab. 7: laser-only AND camera-only cascade (Tab. 4 AND Tab. 5; a detection must pass both)"},
-      {"all_neural",
-       "issue 30: all layers and the network's score layers (neural_person, neural_bicycle, neural_car), "
-       "features a-j"},
+      {"all_neural", "issue 30: all layers and the network's score layers (neural_person, neural_bicycle, neural_car), features a-j"},
       {"neural", "issue 30: the network's score layers alone, features a-j"},
-      {"all_neural_features",
-       "issue 30: all_neural and the network's backbone feature channels (neural_feature_0 .. 7), features "
-       "a-j"},
   };
   return c;
 }
@@ -424,9 +418,6 @@ std::string renderMarkdown(const ExperimentReport& r) {
   };
   weightShares("all", "## Weight share by layer (paper Fig. 7)\n\n");
   weightShares("all_neural", "## Weight share by layer with the network's score layers (issue 30)\n\n");
-  weightShares(
-      "all_neural_features",
-      "## Weight share by layer with the network's score layers and feature channels (issue 30)\n\n");
   if (!r.notes.empty()) {
     md << "## Notes\n\n";
     for (const auto& n : r.notes) md << "- " << n << "\n";

@@ -138,7 +138,7 @@ int runExperiments(ExperimentOptions o) {
   }
   std::fflush(stdout);
 
-  std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf, networkLayersOf(configs));
+  std::vector<DatasetItem> items = loadItems(dataset, manifest, driveOf, withNetwork);
   boosting::DetectionSetup setup;
   setup.scan.scaleFactor = preset.scaleFactor;
   setup.scan.step = preset.step;
@@ -385,8 +385,7 @@ int runExperiments(ExperimentOptions o) {
     std::stable_sort(report.results.begin(), report.results.end(),
                      [&](const ConfigResult& x, const ConfigResult& y) { return rank(x) < rank(y); });
     framesOf[cls][config] = cv.frames;
-    if ((config == "all" || config == "all_neural" || config == "all_neural_features") &&
-        !r.layerWeightShare.empty())
+    if ((config == "all" || config == "all_neural") && !r.layerWeightShare.empty())
       cv::imwrite((o.out / weightShareChartName(cls, config)).string(),
                   weightShareChart(cls + ": weight share by layer (" + config + ", all folds)", r.layerWeightShare));
   };

@@ -6,7 +6,6 @@
 #include <opencv2/dnn.hpp>
 #include <stdexcept>
 
-#include "fusedet/fusion/neural/feature_layers.h"
 #include "fusedet/fusion/neural/sha256.h"
 
 namespace fusedet::fusion {
@@ -53,15 +52,6 @@ int yolov5Rows(cv::Size input) {
   return n;
 }
 
-// The feature map the finest detection head reads, and that head (feature_layers.h).
-struct FeatureTap {
-  std::string tap, head;
-};
-FeatureTap featureTap(NetworkKind kind) {
-  if (kind == NetworkKind::darknet) return {"bn_128", "conv_129"};
-  return {"onnx_node!/model.17/cv3/act/Mul", "onnx_node!/model.24/m.0/Conv"};
-}
-
 }  // namespace
 
 NetworkKind parseNetworkKind(std::string_view text) {
@@ -94,7 +84,6 @@ NetworkRecord NetworkIdentity::record() const {
 struct Network::Impl {
   cv::dnn::Net net;
   std::vector<std::string> outputNames;
-  std::string tapName;  // empty: no feature channels
 };
 
 Network::Network(const NetworkSpec& spec) : spec_(spec), impl_(std::make_unique<Impl>()) {
@@ -113,9 +102,6 @@ Network::Network(const NetworkSpec& spec) : spec_(spec), impl_(std::make_unique<
     throw std::runtime_error(spec.files.front().string() + ": Darknet input size " + sizeText(spec.input) +
                              " is not a multiple of 32 in both directions");
   if (spec.threads < 1) throw std::runtime_error("network: threads must be >= 1, got " + std::to_string(spec.threads));
-  if (spec.featureChannels < 0)
-    throw std::runtime_error("network: feature channels must be >= 0, got " +
-                             std::to_string(spec.featureChannels));
 
   identity_.kind = spec.kind;
   identity_.input = spec.input;
@@ -167,20 +153,6 @@ Network::Network(const NetworkSpec& spec) : spec_(spec), impl_(std::make_unique<
     throw std::runtime_error(spec.files.front().string() + ": not a " + kind + " detector at input size " +
                              sizeText(spec.input) + ": " + e.what());
   }
-  if (spec.featureChannels > 0) {
-    const FeatureTap names = featureTap(spec.kind);
-    if (impl_->net.getLayerId(names.tap) < 0 || impl_->net.getLayerId(names.head) < 0)
-      throw std::runtime_error(
-          spec.files.front().string() + ": no layers '" + names.tap + "' and '" + names.head +
-          "': feature channels are defined for Yolo-Fastest-XL and YOLOv5 (v6 exports) only");
-    try {
-      featureChannels_ =
-          chooseFeatureChannels(impl_->net.getParam(names.head, 0), 5 + classes_, spec.featureChannels);
-    } catch (const std::exception& e) {
-      throw std::runtime_error(spec.files.front().string() + ": " + e.what());
-    }
-    impl_->tapName = names.tap;
-  }
 }
 
 Network::~Network() = default;
@@ -200,35 +172,21 @@ NetworkOutput Network::forward(const cv::Mat& bgr) {
   const bool setThreads = previousThreads != spec_.threads;
   if (setThreads) cv::setNumThreads(spec_.threads);
   std::vector<cv::Mat> outputs;
-  std::vector<std::string> names = impl_->outputNames;
-  if (!impl_->tapName.empty()) names.push_back(impl_->tapName);
   try {
     impl_->net.setInput(blob);
-    impl_->net.forward(outputs, names);
+    impl_->net.forward(outputs, impl_->outputNames);
   } catch (...) {
     if (setThreads) cv::setNumThreads(previousThreads);
     throw;
   }
   if (setThreads) cv::setNumThreads(previousThreads);
-  if (!impl_->tapName.empty()) {
-    out.tap = outputs.back().clone();
-    outputs.pop_back();
-  }
   for (const cv::Mat& o : outputs) out.outputs.push_back(o.clone());
   return out;
 }
 
 Anchors Network::run(const cv::Mat& bgr) {
-  NetworkOutput o = forward(bgr);
-  features_.geometry = o.geometry;
-  features_.tap = o.tap;
+  const NetworkOutput o = forward(bgr);
   return spec_.kind == NetworkKind::darknet ? decodeDarknet(o.outputs, o.geometry) : decodeYolov5(o.outputs.at(0), o.geometry);
-}
-
-NetworkOutput Network::takeFeatures() {
-  NetworkOutput taken;
-  std::swap(taken, features_);
-  return taken;
 }
 
 }  // namespace fusedet::fusion

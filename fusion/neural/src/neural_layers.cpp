@@ -6,8 +6,6 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
-#include "fusedet/fusion/neural/feature_layers.h"
-
 namespace fusedet::fusion {
 
 std::filesystem::path defaultNetworksDir() {
@@ -27,7 +25,6 @@ NetworkSpec networkSpecFor(const NeuralLayerOptions& o) {
   spec.kind = o.kind;
   spec.input = o.input;
   spec.threads = o.threads;
-  spec.featureChannels = o.features;
   if (o.files.empty()) {
     spec.files = defaultNetworkFiles(o.kind, dir);
   } else {
@@ -55,18 +52,6 @@ std::string outputProblem(const Anchors& a, std::size_t rows, int classes) {
   return {};
 }
 
-// Why a run's tap cannot give the chosen channels of an image of `image` size (empty: it can).
-std::string tapProblem(const NetworkOutput& f, const std::vector<int>& channels, cv::Size image) {
-  if (f.tap.empty()) return "no feature map";
-  if (f.tap.dims != 4 || f.tap.size[0] != 1 || f.tap.type() != CV_32F)
-    return "a feature map that is not a float 1 x C x h x w blob";
-  for (int c : channels)
-    if (c >= f.tap.size[1]) return "a feature map of " + std::to_string(f.tap.size[1]) + " channels";
-  if (f.geometry.image != image) return "a feature map of another image";
-  if (!cv::checkRange(f.tap, true)) return "a feature value that is not finite";
-  return {};
-}
-
 }  // namespace
 
 NeuralLayers::NeuralLayers(const NeuralLayerOptions& options, NetworkRun run)
@@ -80,7 +65,6 @@ void NeuralLayers::add(LayerStack& stack, const cv::Mat& bgr) const {
   if (stack.width() < 1 || stack.height() < 1)
     throw std::invalid_argument("neural layers: the stack has no reference size");
   Anchors anchors;
-  NetworkOutput features;
   const auto failed = [&](const std::string& problem) {
     return std::runtime_error("network " + network_.identity().text() + " on a " + std::to_string(bgr.cols) + "x" +
                               std::to_string(bgr.rows) + " image: " + problem);
@@ -88,9 +72,7 @@ void NeuralLayers::add(LayerStack& stack, const cv::Mat& bgr) const {
   {
     std::lock_guard lock(mutex_);
     try {
-      network_.takeFeatures();  // none left from a run that failed
       anchors = run_(network_, bgr);
-      features = network_.takeFeatures();
     } catch (const cv::Exception& e) {
       throw failed("cv::dnn failed: " + e.err);
     } catch (const std::exception& e) {
@@ -99,25 +81,18 @@ void NeuralLayers::add(LayerStack& stack, const cv::Mat& bgr) const {
   }
   if (const std::string problem = outputProblem(anchors, network_.anchorRows(), network_.classes()); !problem.empty())
     throw failed("output of " + problem);
-  const std::vector<int>& channels = network_.featureChannels();
-  if (!channels.empty())
-    if (const std::string problem = tapProblem(features, channels, bgr.size()); !problem.empty())
-      throw failed("output of " + problem);
   // The image may be smaller than the reference grid (camera layers at a lower resolution): the
   // boxes go to reference pixels.
   const double sx = static_cast<double>(stack.width()) / bgr.cols, sy = static_cast<double>(stack.height()) / bgr.rows;
   if (sx != 1.0 || sy != 1.0)
     for (Box& b : anchors.boxes) b = Box{b.x * sx, b.y * sy, b.w * sx, b.h * sy};
   addScoreLayers(stack, anchors, scale_);
-  if (!channels.empty()) addFeatureLayers(stack, features.tap, channels, features.geometry, scale_);
   stack.network = record();
 }
 
 std::vector<std::string> NeuralLayers::layerNames() const {
   std::vector<std::string> names;
   for (const ScoreLayerClass& c : defaultScoreLayers()) names.push_back(c.layer);
-  for (std::size_t rank = 0; rank < network_.featureChannels().size(); ++rank)
-    names.push_back(featureLayerName(static_cast<int>(rank)));
   return names;
 }
 

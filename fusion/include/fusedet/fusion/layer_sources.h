@@ -4,8 +4,7 @@
 // can be summed per source: what each sensor contributes (issue 15).
 //  camera: red, green, blue, intensity, hue, hue_distance (paper Fig. 3)
 //  laser:  distance, remission (paper Fig. 3)
-//  network: neural_<class>, neural_feature_<rank> (a pretrained network's score layers and
-//           backbone channels, fusion/neural; issue 30)
+//  network: neural_<class> (a pretrained network's score layers, fusion/neural; issue 30)
 
 #include <map>
 #include <string>
@@ -23,8 +22,6 @@ std::string toString(LayerSource source);  // "camera", "laser", "network", "oth
 const std::vector<std::string>& paperPoolLayers();
 // The network's score layers (fusion/neural/score_layers.h defaultScoreLayers), in its order.
 const std::vector<std::string>& networkPoolLayers();
-// The network's first kPoolFeatureChannels backbone channels (fusion/neural/feature_layers.h).
-const std::vector<std::string>& networkFeatureLayers();
 
 // Shares per layer summed per source (keys: toString of the source); sources without a layer in
 // `shares` are absent. Unknown layer names sum under "other".

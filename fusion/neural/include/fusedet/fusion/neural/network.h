@@ -42,7 +42,6 @@ struct NetworkSpec {
   std::vector<std::filesystem::path> files;  // darknet: cfg, weights; yolov5-onnx: the .onnx file
   cv::Size input;                            // W x H the network runs at
   int threads = 1;                           // OpenCV threads during a run
-  int featureChannels = 0;                   // backbone channels a run also keeps (feature_layers.h)
 };
 
 struct NetworkIdentity {
@@ -63,16 +62,13 @@ struct NetworkIdentity {
 struct NetworkOutput {
   InputGeometry geometry;
   std::vector<cv::Mat> outputs;  // cv::dnn's unconnected output layers, in its order (owned copies)
-  cv::Mat tap;                   // the feature map feature_layers.h names, 1 x C x h x w; empty
-                                 // when the spec asks no feature channels
 };
 
 class Network {
  public:
   // Throws std::runtime_error naming the file and the problem: a missing or unreadable file, a
   // file that is not of `kind`, a wrong number of files, an input size that is not positive, not
-  // a multiple of 32 (darknet) or refused by the network; feature channels asked of a network
-  // without the kind's tap and head layers (feature_layers.h), or more than the tap has.
+  // a multiple of 32 (darknet) or refused by the network.
   explicit Network(const NetworkSpec& spec);
   ~Network();
   Network(Network&&) noexcept;
@@ -85,17 +81,10 @@ class Network {
   std::size_t anchorRows() const { return anchorRows_; }
   int classes() const { return classes_; }
 
-  // The tap's channels chosen at load (feature_layers.h), in rank order; empty when none asked.
-  const std::vector<int>& featureChannels() const { return featureChannels_; }
-
   // One forward pass on an 8-bit BGR image of any size.
   NetworkOutput forward(const cv::Mat& bgr);
-  // forward() decoded by the kind's convention (anchors.h): boxes in the image's pixels. With
-  // feature channels, the run's tap and geometry are kept for takeFeatures().
+  // forward() decoded by the kind's convention (anchors.h): boxes in the image's pixels.
   Anchors run(const cv::Mat& bgr);
-  // The tap and geometry of the last run() (tap empty when none since the last take), then forgets
-  // them: a caller never gets another run's features.
-  NetworkOutput takeFeatures();
 
  private:
   struct Impl;
@@ -103,8 +92,6 @@ class Network {
   NetworkIdentity identity_;
   std::size_t anchorRows_ = 0;
   int classes_ = 0;
-  std::vector<int> featureChannels_;
-  NetworkOutput features_;  // the last run's tap and geometry (outputs left empty)
   std::unique_ptr<Impl> impl_;
 };
 

@@ -2,8 +2,7 @@
 #pragma once
 // The network as one more layer source of a stack (issue 30; paper §3.2: one more sensor in the
 // joint feature pool). NeuralLayers runs the configured network once on a stack's camera image
-// and adds its score layers (score_layers.h: neural_person, neural_bicycle, neural_car), with
-// `features` > 0 that many backbone channels (feature_layers.h: neural_feature_0, ...), and the
+// and adds its score layers (score_layers.h: neural_person, neural_bicycle, neural_car) and the
 // network's record (LayerStack::network). The Fuser calls it (fuser.h), so KITTI import, training
 // data, `fusedet detect` and fusedetd make these layers by the same code.
 //
@@ -30,9 +29,8 @@ struct NeuralLayerOptions {
   std::vector<std::filesystem::path> files;  // empty: the kind's default files in `directory`
   std::filesystem::path directory;           // empty: defaultNetworksDir()
   cv::Size input{832, 256};                  // W x H
-  double scale = 0.5;                        // the layers' grid relative to the reference size
+  double scale = 0.5;                        // score layers' grid relative to the reference size
   int threads = 1;                           // OpenCV threads during a run
-  int features = 0;                          // backbone feature channels (feature_layers.h)
 };
 
 // $FUSEDET_NETWORKS_DIR, else /usr/share/fusedet/networks.
@@ -57,8 +55,7 @@ class NeuralLayers {
   // `stack`. One run at a time (a mutex): safe to call from several threads.
   // A run that fails adds nothing and throws std::runtime_error naming the network and the
   // problem: cv::dnn threw, or the output is not what the network gave at load (the number of
-  // anchor rows and classes; every score finite and in [0, 1], every box finite; with features a
-  // finite tap holding the chosen channels).
+  // anchor rows and classes; every score finite and in [0, 1], every box finite).
   void add(LayerStack& stack, const cv::Mat& bgr) const;
 
   const NetworkIdentity& identity() const { return network_.identity(); }
